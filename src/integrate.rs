@@ -1,0 +1,50 @@
+//! Symplectic Euler: the predictor (`v* = v + dt f / m`) and the position update
+//! (`x += dt v`) from the velocities the constraint and collision stages filtered.
+//!
+//! Pinned particles have inverse mass 0, so the predictor leaves their prescribed
+//! velocity alone and they move kinematically.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::config::StrandsConfig;
+use crate::schedule::SimulationClock;
+use crate::state::ParticleState;
+
+/// `v += dt w f` for every particle.
+pub fn predict_velocities(velocity: &mut [DVec2], force: &[DVec2], inverse_mass: &[f64], dt: f64) {
+    for ((v, &f), &w) in velocity.iter_mut().zip(force).zip(inverse_mass) {
+        *v += dt * w * f;
+    }
+}
+
+/// `x += dt v` for every particle.
+pub fn advance_positions(position: &mut [DVec2], velocity: &[DVec2], dt: f64) {
+    for (x, &v) in position.iter_mut().zip(velocity) {
+        *x += dt * v;
+    }
+}
+
+/// The Predict stage.
+pub fn predict(config: Res<StrandsConfig>, mut state: ResMut<ParticleState>) {
+    let ParticleState {
+        velocity,
+        force,
+        inverse_mass,
+        ..
+    } = &mut *state;
+    predict_velocities(velocity, force, inverse_mass, config.dt);
+}
+
+/// The Integrate stage; also advances the simulation clock.
+pub fn integrate(
+    config: Res<StrandsConfig>,
+    mut state: ResMut<ParticleState>,
+    mut clock: ResMut<SimulationClock>,
+) {
+    let ParticleState {
+        position, velocity, ..
+    } = &mut *state;
+    advance_positions(position, velocity, config.dt);
+    clock.advance(config.dt);
+}

@@ -1,0 +1,164 @@
+//! Figures of merit, updated by the Measure stage at the end of every step.
+//!
+//! The headline figure is the maximum relative length error `|ℓ − L| / L` over every
+//! edge that should keep its length (every edge but the static ones) at the end of
+//! every step. It is also kept separately for edges none of whose particles took part
+//! in a contact that step, because contact impulses come after the constraint solve.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::state::ParticleState;
+use crate::topology::{Edge, Topology};
+
+/// Running totals of a constraint solver's iterations.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IterationStats {
+    /// Island solves performed.
+    pub solves: u64,
+    /// Iterations summed over all solves.
+    pub iterations: u64,
+    /// Most iterations any one solve took.
+    pub max: u32,
+    /// Solves that stopped at the iteration cap without meeting the tolerance.
+    pub capped: u64,
+}
+
+impl IterationStats {
+    /// Record one island solve.
+    pub fn record(&mut self, iterations: u32, converged: bool) {
+        self.solves += 1;
+        self.iterations += iterations as u64;
+        self.max = self.max.max(iterations);
+        self.capped += u64::from(!converged);
+    }
+
+    /// Mean iterations per solve (0 before any solve).
+    pub fn mean(&self) -> f64 {
+        if self.solves == 0 {
+            0.0
+        } else {
+            self.iterations as f64 / self.solves as f64
+        }
+    }
+}
+
+/// Metrics of the running simulation.
+#[derive(Resource, Default, Debug, Clone)]
+pub struct StrandMetrics {
+    /// Current `|ℓ − L| / L` of every edge of [`Topology::edges`] (0 for static ones).
+    pub relative_length_error: Vec<f64>,
+    /// Largest relative length error at the end of the latest step.
+    pub max_rel_length_error_now: f64,
+    /// Largest relative length error at the end of any step.
+    pub max_rel_length_error: f64,
+    /// As `max_rel_length_error_now`, over edges away from contacts.
+    pub max_rel_length_error_free_now: f64,
+    /// As `max_rel_length_error`, over edges away from contacts.
+    pub max_rel_length_error_free: f64,
+    /// Simulated particles.
+    pub particles: usize,
+    /// Simulated strands.
+    pub strands: usize,
+    /// Edges that are not static.
+    pub edges: usize,
+    /// Edges kept at rest length by the constraint solver.
+    pub constrained_edges: usize,
+    /// Constraint projection iterations per island solve.
+    pub projection: IterationStats,
+    /// Collision impulses applied.
+    pub collisions: u64,
+    /// Collision impulses applied in the latest step.
+    pub collisions_last_step: u64,
+    /// Steps that needed the collision fail-safe.
+    pub failsafe_steps: u64,
+    /// Step ends at which two edges sharing no particle intersected; `None` when not
+    /// checked.
+    pub edge_crossings: Option<u64>,
+    /// Wall-clock seconds spent stepping.
+    pub wall_seconds: f64,
+    /// Wall-clock seconds of the latest tick.
+    pub last_tick_seconds: f64,
+}
+
+impl StrandMetrics {
+    /// Forget the maxima and counters (keeps the counts of the current topology).
+    pub fn reset_figures(&mut self) {
+        *self = Self {
+            relative_length_error: std::mem::take(&mut self.relative_length_error),
+            particles: self.particles,
+            strands: self.strands,
+            edges: self.edges,
+            constrained_edges: self.constrained_edges,
+            edge_crossings: self.edge_crossings.map(|_| 0),
+            ..Self::default()
+        };
+    }
+}
+
+/// `|ℓ − L| / L` of an edge.
+pub fn relative_length_error(edge: &Edge, position: &[DVec2]) -> f64 {
+    let length = position[edge.a as usize].distance(position[edge.b as usize]);
+    (length - edge.rest_length).abs() / edge.rest_length
+}
+
+/// Relative length error of every edge into `errors`; returns the maxima over all
+/// dynamic edges and over those with no particle in contact.
+pub fn measure_length_errors(
+    edges: &[Edge],
+    position: &[DVec2],
+    in_contact: &[bool],
+    errors: &mut [f64],
+) -> (f64, f64) {
+    let (mut all, mut free) = (0.0f64, 0.0f64);
+    for (edge, error) in edges.iter().zip(errors.iter_mut()) {
+        *error = if edge.is_static {
+            0.0
+        } else {
+            relative_length_error(edge, position)
+        };
+        all = all.max(*error);
+        if !(in_contact[edge.a as usize] || in_contact[edge.b as usize]) {
+            free = free.max(*error);
+        }
+    }
+    (all, free)
+}
+
+/// The Measure stage's length figures.
+pub fn measure(
+    topology: Res<Topology>,
+    state: Res<ParticleState>,
+    mut metrics: ResMut<StrandMetrics>,
+) {
+    let metrics = &mut *metrics;
+    if metrics.relative_length_error.len() != topology.edges.len() {
+        metrics
+            .relative_length_error
+            .resize(topology.edges.len(), 0.0);
+    }
+    let (all, free) = measure_length_errors(
+        &topology.edges,
+        &state.position,
+        &state.in_contact,
+        &mut metrics.relative_length_error,
+    );
+    metrics.max_rel_length_error_now = all;
+    metrics.max_rel_length_error_free_now = free;
+    metrics.max_rel_length_error = metrics.max_rel_length_error.max(all);
+    metrics.max_rel_length_error_free = metrics.max_rel_length_error_free.max(free);
+}
+
+/// Refresh the counts after a topology rebuild.
+pub fn count_elements(
+    topology: Res<Topology>,
+    state: Res<ParticleState>,
+    mut metrics: ResMut<StrandMetrics>,
+) {
+    if topology.is_changed() {
+        metrics.particles = state.len();
+        metrics.strands = topology.strands.len();
+        metrics.edges = topology.dynamic_edge_count();
+        metrics.constrained_edges = topology.edges.iter().filter(|e| e.constrained).count();
+    }
+}

@@ -1,0 +1,108 @@
+//! The run report of ../shared/SCENARIOS.md: one JSON object, or a readable table.
+
+use serde::Serialize;
+
+/// Figures of one headless run.
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct Report {
+    /// Scenario name.
+    pub scenario: String,
+    /// The scene parameters actually used (dt, substeps and solver included).
+    pub config: serde_json::Value,
+    /// The constraint solver used.
+    pub solver: String,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated seconds.
+    pub sim_time: f64,
+    /// Particles at the end.
+    pub particles: usize,
+    /// Strands at the end (walls included).
+    pub strands: usize,
+    /// Edges kept at rest length by the constraint solver at the end.
+    pub constrained_edges: usize,
+    /// Largest `|ℓ − L| / L` over every non-static edge and every step end.
+    pub max_rel_length_error: f64,
+    /// The same over edges with no particle in contact that step.
+    pub max_rel_length_error_free: f64,
+    /// Step ends at which two edges sharing no particle intersected; null if unchecked.
+    pub edge_crossings: Option<u64>,
+    /// Collision impulses applied.
+    pub collisions: u64,
+    /// Steps that needed the collision fail-safe.
+    pub failsafe_steps: u64,
+    /// Mean constraint-solve iterations per island per step.
+    pub projection_iterations_mean: f64,
+    /// Most constraint-solve iterations of any island in any step.
+    pub projection_iterations_max: u32,
+    /// Island solves that stopped at the iteration cap.
+    pub projection_capped_solves: u64,
+    /// Wall-clock seconds of the run's ticks.
+    pub wall_seconds: f64,
+    /// Particles × steps per wall-clock second.
+    pub particle_steps_per_second: f64,
+    /// What a reader must know to interpret the figures.
+    pub notes: Vec<String>,
+    /// Problems found in the input, and what was done about them.
+    pub input_problems: Vec<String>,
+}
+
+impl Report {
+    /// The report as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report always serializes")
+    }
+
+    /// The report as an aligned two-column table.
+    pub fn to_table(&self) -> String {
+        let crossings = self
+            .edge_crossings
+            .map_or("not checked".to_string(), |c| c.to_string());
+        let rows: Vec<(&str, String)> = vec![
+            ("scenario", self.scenario.clone()),
+            ("solver", self.solver.clone()),
+            ("steps", self.steps.to_string()),
+            ("sim_time", format!("{:.4} s", self.sim_time)),
+            ("particles", self.particles.to_string()),
+            ("strands", self.strands.to_string()),
+            ("constrained_edges", self.constrained_edges.to_string()),
+            (
+                "max_rel_length_error",
+                format!("{:.3e}", self.max_rel_length_error),
+            ),
+            (
+                "max_rel_length_error_free",
+                format!("{:.3e}", self.max_rel_length_error_free),
+            ),
+            ("edge_crossings", crossings),
+            ("collisions", self.collisions.to_string()),
+            ("failsafe_steps", self.failsafe_steps.to_string()),
+            (
+                "projection_iterations",
+                format!(
+                    "mean {:.2}, max {}, capped {}",
+                    self.projection_iterations_mean,
+                    self.projection_iterations_max,
+                    self.projection_capped_solves
+                ),
+            ),
+            ("wall_seconds", format!("{:.3}", self.wall_seconds)),
+            (
+                "particle_steps_per_second",
+                format!("{:.3e}", self.particle_steps_per_second),
+            ),
+        ];
+        let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+        let mut out = String::new();
+        for (key, value) in rows {
+            out.push_str(&format!("{key:<width$}  {value}\n"));
+        }
+        for note in &self.notes {
+            out.push_str(&format!("note: {note}\n"));
+        }
+        for problem in &self.input_problems {
+            out.push_str(&format!("input problem: {problem}\n"));
+        }
+        out
+    }
+}

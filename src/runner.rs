@@ -1,0 +1,165 @@
+//! The headless runner: a scenario in, a report out, no window and no wall clock in
+//! the loop. The `strands` binary is a thin command line over [`run`].
+
+use std::path::PathBuf;
+
+use bevy::platform::time::Instant;
+use bevy::prelude::*;
+use thiserror::Error;
+
+use crate::StrandsPlugin;
+use crate::config::StrandsConfig;
+use crate::constraints::{ConstraintConfig, SolverKind};
+use crate::metrics::StrandMetrics;
+use crate::report::Report;
+use crate::scene::{Scene, SceneError, spawn_scene};
+use crate::scenes::{builtin, builtin_names};
+use crate::schedule::{SimulationClock, StrandsTick};
+use crate::state::ParticleState;
+use crate::topology::InputProblems;
+
+/// What to run, and the command line's overrides of the scene.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Built-in scenario name (ignored when `scene_file` is given, except in errors).
+    pub scenario: String,
+    /// A scene file to run instead of the built-in one.
+    pub scene_file: Option<PathBuf>,
+    /// Simulated seconds, instead of the scene's duration.
+    pub seconds: Option<f64>,
+    /// Step size, instead of the scene's.
+    pub dt: Option<f64>,
+    /// Steps per tick, instead of the scene's.
+    pub substeps: Option<u32>,
+    /// Constraint solver, instead of the scene's.
+    pub solver: Option<String>,
+    /// Whether to count edge crossings at every step end.
+    pub check_crossings: bool,
+}
+
+/// Why a run could not start.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// The scene is invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// No built-in scenario has that name.
+    #[error("unknown scenario '{name}'; valid scenarios: {valid}")]
+    UnknownScenario {
+        /// The name given.
+        name: String,
+        /// The valid names.
+        valid: String,
+    },
+}
+
+/// The scene the options describe, overrides applied and validated.
+pub fn load_scene(options: &RunOptions) -> Result<Scene, RunError> {
+    let mut scene = match &options.scene_file {
+        Some(path) => Scene::load(path)?,
+        None => builtin(&options.scenario)
+            .ok_or_else(|| RunError::UnknownScenario {
+                name: options.scenario.clone(),
+                valid: builtin_names().join(", "),
+            })?
+            .scene()?,
+    };
+    if let Some(seconds) = options.seconds {
+        scene.duration = seconds;
+    }
+    if let Some(dt) = options.dt {
+        scene.dt = dt;
+    }
+    if let Some(substeps) = options.substeps {
+        scene.substeps = substeps;
+    }
+    if let Some(solver) = &options.solver {
+        scene.solver = solver.clone();
+    }
+    scene.validate("command line")?;
+    Ok(scene)
+}
+
+/// An app with the simulation driven by hand and the scene spawned.
+pub fn headless_app(scene: &Scene) -> Result<App, RunError> {
+    let mut app = App::new();
+    app.add_plugins(StrandsPlugin::manual());
+    app.finish();
+    app.cleanup();
+    spawn_scene(app.world_mut(), scene)?;
+    Ok(app)
+}
+
+/// Run the scene for its duration and report. `progress` is told the fraction done
+/// after every tick.
+pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report, RunError> {
+    let scene = load_scene(options)?;
+    let mut app = headless_app(&scene)?;
+    let world = app.world_mut();
+
+    let total_steps = (scene.duration / scene.dt).round().max(1.0) as u64;
+    let mut particle_steps = 0u64;
+    let start = Instant::now();
+    loop {
+        let steps = world.resource::<SimulationClock>().steps;
+        if steps >= total_steps {
+            break;
+        }
+        let substeps = (total_steps - steps).min(scene.substeps as u64) as u32;
+        world.resource_mut::<StrandsConfig>().substeps = substeps;
+        world.run_schedule(StrandsTick);
+        particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
+        progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
+    }
+    let wall_seconds = start.elapsed().as_secs_f64();
+    Ok(report(world, &scene, wall_seconds, particle_steps))
+}
+
+fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) -> Report {
+    let metrics = world.resource::<StrandMetrics>();
+    let clock = world.resource::<SimulationClock>();
+    let solver = world.resource::<ConstraintConfig>().solver;
+    let mut notes = Vec::new();
+    if solver == SolverKind::Springs {
+        notes.push(
+            "solver springs: no constraints; every edge is a stretch spring, so lengths \
+             follow the spring stiffness"
+                .to_string(),
+        );
+    }
+    if metrics.edge_crossings.is_none() {
+        notes.push("edge crossings were not checked".to_string());
+    }
+    let input_problems = world
+        .resource::<InputProblems>()
+        .entries
+        .iter()
+        .map(|p| format!("{}: {}", p.entity, p.problem))
+        .collect();
+    Report {
+        scenario: scene.name.clone(),
+        config: serde_json::to_value(scene).expect("a scene always serializes"),
+        solver: solver.name().to_string(),
+        steps: clock.steps,
+        sim_time: clock.time,
+        particles: metrics.particles,
+        strands: metrics.strands,
+        constrained_edges: metrics.constrained_edges,
+        max_rel_length_error: metrics.max_rel_length_error,
+        max_rel_length_error_free: metrics.max_rel_length_error_free,
+        edge_crossings: metrics.edge_crossings,
+        collisions: metrics.collisions,
+        failsafe_steps: metrics.failsafe_steps,
+        projection_iterations_mean: metrics.projection.mean(),
+        projection_iterations_max: metrics.projection.max,
+        projection_capped_solves: metrics.projection.capped,
+        wall_seconds,
+        particle_steps_per_second: if wall_seconds > 0.0 {
+            particle_steps as f64 / wall_seconds
+        } else {
+            0.0
+        },
+        notes,
+        input_problems,
+    }
+}

@@ -1,0 +1,446 @@
+//! Scene files: a scenario's parameters as a human-readable RON file, validated on
+//! load, then spawned into a world.
+//!
+//! Every figure the project quotes comes from a scene under `assets/scenes/`; a scene
+//! that cannot be simulated is refused with an error naming the file, the item and the
+//! problem, before anything is spawned.
+
+mod spawn;
+
+pub use spawn::spawn_scene;
+
+use std::path::Path;
+
+use bevy::math::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::constraints::SolverKind;
+use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
+
+/// A problem with a scene file: which file, which item in it, and what is wrong.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("{file}: {item}: {problem}")]
+pub struct SceneError {
+    /// The file (or the built-in scene's name).
+    pub file: String,
+    /// The item in the file, e.g. `strands[2].spacing`.
+    pub item: String,
+    /// What is wrong with it.
+    pub problem: String,
+}
+
+/// A scenario: the step, the forces, the solver and what to spawn.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Scenario name.
+    pub name: String,
+    /// One line on what the scenario shows.
+    #[serde(default)]
+    pub description: String,
+    /// Simulated seconds a run covers.
+    pub duration: f64,
+    /// Step size in seconds.
+    pub dt: f64,
+    /// Steps per tick.
+    pub substeps: u32,
+    /// Gravity acceleration.
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 2],
+    /// Mass-proportional damping (1/s).
+    #[serde(default)]
+    pub damping: f64,
+    /// Constraint solver name (see `strands run --help`).
+    #[serde(default = "default_solver")]
+    pub solver: String,
+    /// Default material of the strands.
+    #[serde(default)]
+    pub material: MaterialSpec,
+    /// An axis-aligned box of pinned walls.
+    #[serde(default)]
+    pub container: Option<ContainerSpec>,
+    /// Strands.
+    #[serde(default)]
+    pub strands: Vec<StrandSpec>,
+    /// Loose particles.
+    #[serde(default)]
+    pub particles: Vec<ParticleSpec>,
+}
+
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.81]
+}
+
+fn default_solver() -> String {
+    SolverKind::default().name().to_string()
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Material parameters (see [`StrandMaterial`]).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct MaterialSpec {
+    /// Stretch stiffness per unit strain.
+    pub stretch_stiffness: f64,
+    /// Stretch damping along the edge.
+    pub stretch_damping: f64,
+    /// Bending stiffness.
+    pub bending_stiffness: f64,
+    /// Bending damping.
+    pub bending_damping: f64,
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        StrandMaterial::default().into()
+    }
+}
+
+impl From<StrandMaterial> for MaterialSpec {
+    fn from(m: StrandMaterial) -> Self {
+        Self {
+            stretch_stiffness: m.stretch_stiffness,
+            stretch_damping: m.stretch_damping,
+            bending_stiffness: m.bending_stiffness,
+            bending_damping: m.bending_damping,
+        }
+    }
+}
+
+impl From<MaterialSpec> for StrandMaterial {
+    fn from(m: MaterialSpec) -> Self {
+        Self {
+            stretch_stiffness: m.stretch_stiffness,
+            stretch_damping: m.stretch_damping,
+            bending_stiffness: m.bending_stiffness,
+            bending_damping: m.bending_damping,
+        }
+    }
+}
+
+/// Walls: a closed loop of four pinned particles at the corners of a box.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContainerSpec {
+    /// Lower-left corner.
+    pub min: [f64; 2],
+    /// Upper-right corner.
+    pub max: [f64; 2],
+}
+
+/// The shape a strand starts in.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// A straight open strand from `start` at `angle_degrees` from the +x axis.
+    Line {
+        /// First particle.
+        start: [f64; 2],
+        /// Direction, degrees counter-clockwise from +x.
+        angle_degrees: f64,
+        /// Particle count.
+        particles: usize,
+        /// Rest spacing.
+        spacing: f64,
+    },
+    /// An open strand through the points.
+    Polyline {
+        /// The particles' positions.
+        points: Vec<[f64; 2]>,
+    },
+    /// A closed loop through the points, keeping their shape at rest.
+    Polygon {
+        /// The particles' positions.
+        points: Vec<[f64; 2]>,
+    },
+}
+
+/// What a strand represents (its colour in pictures).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KindSpec {
+    /// A generic rope.
+    #[default]
+    Rope,
+    /// Spaghetti.
+    Spaghetti,
+    /// A meatball loop.
+    Meatball,
+    /// A hair.
+    Hair,
+}
+
+impl From<KindSpec> for StrandKind {
+    fn from(k: KindSpec) -> Self {
+        match k {
+            KindSpec::Rope => StrandKind::Rope,
+            KindSpec::Spaghetti => StrandKind::Spaghetti,
+            KindSpec::Meatball => StrandKind::Meatball,
+            KindSpec::Hair => StrandKind::Hair,
+        }
+    }
+}
+
+/// A strand in a scene file.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StrandSpec {
+    /// Initial shape.
+    pub shape: ShapeSpec,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Initial velocity of each particle.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Indices of pinned particles.
+    #[serde(default)]
+    pub pinned: Vec<usize>,
+    /// Rest lengths, when not the initial distances.
+    #[serde(default)]
+    pub rest_lengths: Option<Vec<f64>>,
+    /// What it represents.
+    #[serde(default)]
+    pub kind: KindSpec,
+    /// Material, when not the scene's default.
+    #[serde(default)]
+    pub material: Option<MaterialSpec>,
+}
+
+/// A particle on its own.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    /// Position.
+    pub position: [f64; 2],
+    /// Velocity.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Mass.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Pinned.
+    #[serde(default)]
+    pub pinned: bool,
+}
+
+pub(crate) fn vec2(v: [f64; 2]) -> DVec2 {
+    DVec2::new(v[0], v[1])
+}
+
+impl StrandSpec {
+    /// The builder this spec describes (not yet validated).
+    pub fn builder(&self) -> StrandBuilder {
+        let builder = match &self.shape {
+            ShapeSpec::Line {
+                start,
+                angle_degrees,
+                particles,
+                spacing,
+            } => {
+                let direction = DVec2::from_angle(angle_degrees.to_radians());
+                StrandBuilder::line(vec2(*start), direction, *particles, *spacing)
+            }
+            ShapeSpec::Polyline { points } => {
+                StrandBuilder::polyline(points.iter().map(|&p| vec2(p)))
+            }
+            ShapeSpec::Polygon { points } => {
+                StrandBuilder::closed_loop(points.iter().map(|&p| vec2(p)))
+            }
+        };
+        let mut builder = builder
+            .mass(self.mass)
+            .velocity(vec2(self.velocity))
+            .kind(self.kind.into());
+        for &i in &self.pinned {
+            builder = builder.pin(i);
+        }
+        if let Some(lengths) = &self.rest_lengths {
+            builder = builder.rest_lengths(lengths.clone());
+        }
+        if let Some(material) = self.material {
+            builder = builder.material(material.into());
+        }
+        builder
+    }
+}
+
+impl Scene {
+    /// Parse and validate a scene from RON text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = ron::from_str(text).map_err(|e| SceneError {
+            file: file.to_string(),
+            item: format!("line {}, column {}", e.span.start.line, e.span.start.col),
+            problem: e.code.to_string(),
+        })?;
+        scene.validate(file)?;
+        Ok(scene)
+    }
+
+    /// Read, parse and validate a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: file.clone(),
+            item: "file".to_string(),
+            problem: e.to_string(),
+        })?;
+        Self::parse(&text, &file)
+    }
+
+    /// The constraint solver the scene asks for.
+    pub fn solver_kind(&self) -> Result<SolverKind, String> {
+        self.solver.parse()
+    }
+
+    /// Check every number and every item; the first problem found is returned.
+    pub fn validate(&self, file: &str) -> Result<(), SceneError> {
+        let fail = |item: &str, problem: String| SceneError {
+            file: file.to_string(),
+            item: item.to_string(),
+            problem,
+        };
+        if self.name.trim().is_empty() {
+            return Err(fail("name", "must not be empty".into()));
+        }
+        positive("duration", self.duration).map_err(|p| fail("duration", p))?;
+        positive("dt", self.dt).map_err(|p| fail("dt", p))?;
+        if self.substeps == 0 {
+            return Err(fail("substeps", "must be at least 1".into()));
+        }
+        finite2(self.gravity).map_err(|p| fail("gravity", p))?;
+        non_negative(self.damping).map_err(|p| fail("damping", p))?;
+        self.solver_kind().map_err(|p| fail("solver", p))?;
+        self.material
+            .validate()
+            .map_err(|(field, p)| fail(&format!("material.{field}"), p))?;
+        if let Some(container) = &self.container {
+            finite2(container.min).map_err(|p| fail("container.min", p))?;
+            finite2(container.max).map_err(|p| fail("container.max", p))?;
+            if !(container.min[0] < container.max[0] && container.min[1] < container.max[1]) {
+                return Err(fail(
+                    "container",
+                    format!(
+                        "min {:?} must be below and left of max {:?}",
+                        container.min, container.max
+                    ),
+                ));
+            }
+        }
+        for (i, strand) in self.strands.iter().enumerate() {
+            let item = format!("strands[{i}]");
+            strand
+                .validate()
+                .map_err(|(field, p)| fail(&format!("{item}{field}"), p))?;
+        }
+        for (i, particle) in self.particles.iter().enumerate() {
+            let item = format!("particles[{i}]");
+            finite2(particle.position).map_err(|p| fail(&format!("{item}.position"), p))?;
+            finite2(particle.velocity).map_err(|p| fail(&format!("{item}.velocity"), p))?;
+            if !particle.pinned {
+                positive("mass", particle.mass).map_err(|p| fail(&format!("{item}.mass"), p))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl MaterialSpec {
+    fn validate(&self) -> Result<(), (&'static str, String)> {
+        let fields = [
+            ("stretch_stiffness", self.stretch_stiffness),
+            ("stretch_damping", self.stretch_damping),
+            ("bending_stiffness", self.bending_stiffness),
+            ("bending_damping", self.bending_damping),
+        ];
+        for (name, value) in fields {
+            non_negative(value).map_err(|p| (name, p))?;
+        }
+        Ok(())
+    }
+}
+
+impl StrandSpec {
+    /// Validate; on failure, the field (with a leading `.`) and the problem.
+    fn validate(&self) -> Result<(), (String, String)> {
+        let at = |field: &str, problem: String| (format!(".{field}"), problem);
+        match &self.shape {
+            ShapeSpec::Line {
+                start,
+                angle_degrees,
+                particles,
+                spacing,
+            } => {
+                finite2(*start).map_err(|p| at("shape.start", p))?;
+                if !angle_degrees.is_finite() {
+                    return Err(at(
+                        "shape.angle_degrees",
+                        format!("{angle_degrees} is not finite"),
+                    ));
+                }
+                if *particles < 2 {
+                    return Err(at(
+                        "shape.particles",
+                        format!("a strand needs at least 2 particles, got {particles}"),
+                    ));
+                }
+                if !(spacing.is_finite() && *spacing > 0.0) {
+                    return Err(at(
+                        "shape.spacing",
+                        format!(
+                            "{spacing} would make a zero or negative rest length; it must be positive"
+                        ),
+                    ));
+                }
+            }
+            ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => {
+                for (j, &p) in points.iter().enumerate() {
+                    finite2(p).map_err(|problem| at(&format!("shape.points[{j}]"), problem))?;
+                }
+            }
+        }
+        if let Some(material) = &self.material {
+            material
+                .validate()
+                .map_err(|(f, p)| at(&format!("material.{f}"), p))?;
+        }
+        finite2(self.velocity).map_err(|p| at("velocity", p))?;
+        if !(self.mass.is_finite() && self.mass > 0.0) {
+            return Err(at(
+                "mass",
+                format!("{} must be positive and finite", self.mass),
+            ));
+        }
+        self.builder()
+            .validate()
+            .map(|_| ())
+            .map_err(|e| (String::new(), e.to_string()))
+    }
+}
+
+fn finite2(v: [f64; 2]) -> Result<(), String> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("({}, {}) is not finite", v[0], v[1]))
+    }
+}
+
+fn positive(name: &str, x: f64) -> Result<(), String> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{name} {x} must be positive and finite"))
+    }
+}
+
+fn non_negative(x: f64) -> Result<(), String> {
+    if x.is_finite() && x >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{x} must be zero or positive and finite"))
+    }
+}

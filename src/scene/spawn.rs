@@ -1,0 +1,72 @@
+//! Spawning a validated scene into a world.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use super::{Scene, SceneError, vec2};
+use crate::config::StrandsConfig;
+use crate::constraints::ConstraintConfig;
+use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
+use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
+
+/// Configure the world's resources from the scene and spawn its walls, strands and
+/// particles. The scene must have passed [`Scene::validate`].
+pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
+    let fail = |item: String, problem: String| SceneError {
+        file: scene.name.clone(),
+        item,
+        problem,
+    };
+    let solver = scene.solver_kind().map_err(|p| fail("solver".into(), p))?;
+    {
+        let mut config = world.resource_mut::<StrandsConfig>();
+        config.dt = scene.dt;
+        config.substeps = scene.substeps;
+        config.gravity = vec2(scene.gravity);
+        config.damping = scene.damping;
+        config.material = scene.material.into();
+    }
+    world.get_resource_or_init::<ConstraintConfig>().solver = solver;
+
+    if let Some(container) = &scene.container {
+        container_builder(vec2(container.min), vec2(container.max))
+            .spawn_in(world)
+            .map_err(|e| fail("container".into(), e.to_string()))?;
+    }
+    for (i, strand) in scene.strands.iter().enumerate() {
+        strand
+            .builder()
+            .spawn_in(world)
+            .map_err(|e| fail(format!("strands[{i}]"), e.to_string()))?;
+    }
+    for particle in &scene.particles {
+        let mut entity = world.spawn((
+            Particle,
+            Position(vec2(particle.position)),
+            Velocity(vec2(particle.velocity)),
+            Mass(particle.mass),
+        ));
+        if particle.pinned {
+            entity.insert(Pinned);
+        }
+    }
+    Ok(())
+}
+
+/// The walls of an axis-aligned box: a closed loop of four pinned particles, with no
+/// springs or bending (its edges are static obstacles).
+pub fn container_builder(min: DVec2, max: DVec2) -> StrandBuilder {
+    let corners = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)];
+    let mut builder = StrandBuilder::closed_loop(corners)
+        .kind(StrandKind::Wall)
+        .material(StrandMaterial {
+            stretch_stiffness: 0.0,
+            stretch_damping: 0.0,
+            bending_stiffness: 0.0,
+            bending_damping: 0.0,
+        });
+    for i in 0..4 {
+        builder = builder.pin(i);
+    }
+    builder
+}

@@ -1,0 +1,39 @@
+//! The canonical scenarios of ../shared/SCENARIOS.md, built into the crate so the
+//! runner works from anywhere. Their text is the scene file under `assets/scenes/`.
+
+use crate::scene::{Scene, SceneError};
+
+/// A scenario shipped with the crate.
+#[derive(Clone, Copy, Debug)]
+pub struct BuiltinScene {
+    /// Name, as given to `strands run`.
+    pub name: &'static str,
+    /// Path of its scene file in the repository.
+    pub file: &'static str,
+    /// The scene file's text.
+    pub text: &'static str,
+}
+
+impl BuiltinScene {
+    /// Parse and validate the scene.
+    pub fn scene(&self) -> Result<Scene, SceneError> {
+        Scene::parse(self.text, self.file)
+    }
+}
+
+/// Every built-in scenario.
+pub const BUILTIN_SCENES: &[BuiltinScene] = &[BuiltinScene {
+    name: "long_strand",
+    file: "assets/scenes/long_strand.ron",
+    text: include_str!("../../assets/scenes/long_strand.ron"),
+}];
+
+/// The built-in scenario called `name`.
+pub fn builtin(name: &str) -> Option<&'static BuiltinScene> {
+    BUILTIN_SCENES.iter().find(|s| s.name == name)
+}
+
+/// The names of the built-in scenarios.
+pub fn builtin_names() -> Vec<&'static str> {
+    BUILTIN_SCENES.iter().map(|s| s.name).collect()
+}

@@ -1,0 +1,535 @@
+//! Topology: which particles are simulated, in which packed order, and the edges and
+//! bending elements between them.
+//!
+//! Rebuilt only when something structural changes — a particle or strand added or
+//! removed, a pin toggled, a strand edited — never rediscovered every step. The
+//! rebuild is also where input is validated: bad particles and strands are left out
+//! with a message in [`InputProblems`], and strands that reference despawned
+//! particles are split around the gap.
+
+use std::collections::HashSet;
+use std::ops::Range;
+
+use bevy::ecs::entity::{EntityHashMap, EntityHashSet};
+use bevy::ecs::world::DeferredWorld;
+use bevy::prelude::*;
+
+use crate::config::StrandsConfig;
+use crate::particle::{Mass, Particle, Pinned, Position, SolverIndex, Velocity};
+use crate::state::{ParticleState, particle_problem};
+use crate::strand::{Strand, StrandKind, StrandMaterial, StrandOf, bend_count, edge_count};
+
+/// An edge between two packed particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Edge {
+    /// First particle (packed index).
+    pub a: u32,
+    /// Second particle (packed index).
+    pub b: u32,
+    /// Rest length.
+    pub rest_length: f64,
+    /// Index of the owning strand in [`Topology::strands`].
+    pub strand: u32,
+    /// Both ends pinned: the edge never changes and is only an obstacle.
+    pub is_static: bool,
+    /// Kept at its rest length by the constraint solver.
+    pub constrained: bool,
+    /// Carries a stretch spring.
+    pub spring: bool,
+    /// Stretch spring stiffness per unit strain.
+    pub stiffness: f64,
+    /// Stretch spring damping along the edge.
+    pub damping: f64,
+}
+
+/// A bending element at particle `s` between edges (a, s) and (s, b).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bend {
+    /// Previous particle.
+    pub a: u32,
+    /// The vertex.
+    pub s: u32,
+    /// Next particle.
+    pub b: u32,
+    /// Rest turning angle.
+    pub rest_angle: f64,
+    /// `k_b / ℓ̄`: stiffness over the vertex's Voronoi length.
+    pub stiffness: f64,
+    /// Damping of the turning-angle rate.
+    pub damping: f64,
+}
+
+/// A simulated strand.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StrandRecord {
+    /// The strand entity.
+    pub entity: Entity,
+    /// What it represents.
+    pub kind: StrandKind,
+    /// Its edges in [`Topology::edges`].
+    pub edges: Range<usize>,
+    /// Whether it is a loop.
+    pub closed: bool,
+}
+
+/// The simulated structure, rebuilt on structural change.
+#[derive(Resource, Default, Debug)]
+pub struct Topology {
+    /// Incremented by every rebuild; caches derived from the topology compare it.
+    pub version: u64,
+    dirty: bool,
+    /// Packed index of every simulated particle.
+    pub index: EntityHashMap<u32>,
+    /// All edges, strand by strand.
+    pub edges: Vec<Edge>,
+    /// All bending elements.
+    pub bends: Vec<Bend>,
+    /// All simulated strands.
+    pub strands: Vec<StrandRecord>,
+    /// The default material the elements were built with.
+    default_material: Option<StrandMaterial>,
+}
+
+impl Topology {
+    /// Ask for a rebuild at the start of the next tick.
+    pub fn mark_changed(&mut self) {
+        self.dirty = true;
+    }
+
+    /// Whether a rebuild is pending.
+    pub fn is_dirty(&self) -> bool {
+        self.dirty
+    }
+
+    /// Number of edges that are not static.
+    pub fn dynamic_edge_count(&self) -> usize {
+        self.edges.iter().filter(|e| !e.is_static).count()
+    }
+}
+
+/// Flag a pending topology rebuild from a component hook.
+pub(crate) fn mark_topology_changed(mut world: DeferredWorld) {
+    if let Some(mut topology) = world.get_resource_mut::<Topology>() {
+        topology.dirty = true;
+    }
+}
+
+/// A problem found in the input, naming the entity it concerns.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InputProblem {
+    /// The particle or strand.
+    pub entity: Entity,
+    /// What is wrong and what was done about it.
+    pub problem: String,
+}
+
+/// Problems found in the input since start-up. Each distinct problem is logged once.
+#[derive(Resource, Default, Debug)]
+pub struct InputProblems {
+    /// Every problem, in the order found.
+    pub entries: Vec<InputProblem>,
+    seen: HashSet<(Entity, String)>,
+}
+
+impl InputProblems {
+    /// Record (and log, the first time) a problem with `entity`.
+    pub fn report(&mut self, entity: Entity, problem: impl Into<String>) {
+        let problem = problem.into();
+        if self.seen.insert((entity, problem.clone())) {
+            warn!("bevy_strands: {entity}: {problem}");
+            self.entries.push(InputProblem { entity, problem });
+        }
+    }
+
+    /// Whether any problem mentions `entity`.
+    pub fn concerns(&self, entity: Entity) -> bool {
+        self.entries.iter().any(|p| p.entity == entity)
+    }
+}
+
+/// Mark the topology dirty when a strand was edited in place.
+pub fn detect_strand_edits(
+    mut topology: ResMut<Topology>,
+    config: Res<StrandsConfig>,
+    edited: Query<(), Or<(Changed<Strand>, Changed<StrandMaterial>)>>,
+) {
+    if !edited.is_empty() || topology.default_material != Some(config.material) {
+        topology.dirty = true;
+    }
+}
+
+/// Run condition: a rebuild is pending.
+pub fn topology_dirty(topology: Res<Topology>) -> bool {
+    topology.dirty
+}
+
+/// Rebuild the topology and re-index the particles.
+pub fn rebuild_topology(world: &mut World) {
+    split_strands_with_missing_particles(world);
+
+    let default_material = world.resource::<StrandsConfig>().material;
+    let mut problems = world.remove_resource::<InputProblems>().unwrap_or_default();
+
+    // Particles that can be simulated, and whether each is pinned.
+    let mut particles = world
+        .query_filtered::<(Entity, &Position, &Velocity, &Mass, Has<Pinned>), With<Particle>>();
+    let mut valid: EntityHashMap<bool> = EntityHashMap::default();
+    for (entity, position, velocity, mass, pinned) in particles.iter(world) {
+        match particle_problem(position.0, velocity.0, mass.0, pinned) {
+            Some(problem) => problems.report(entity, format!("particle left out: {problem}")),
+            None => {
+                valid.insert(entity, pinned);
+            }
+        }
+    }
+
+    let mut strand_query = world.query::<(
+        Entity,
+        &Strand,
+        Option<&StrandMaterial>,
+        Option<&StrandKind>,
+    )>();
+    let mut strands: Vec<(Entity, &Strand, StrandMaterial, StrandKind)> = strand_query
+        .iter(world)
+        .filter_map(
+            |(entity, strand, material, kind)| match strand_problem(strand, &valid) {
+                Some(problem) => {
+                    problems.report(entity, format!("strand left out: {problem}"));
+                    None
+                }
+                None => Some((
+                    entity,
+                    strand,
+                    material.copied().unwrap_or(default_material),
+                    kind.copied().unwrap_or_default(),
+                )),
+            },
+        )
+        .collect();
+    strands.sort_by_key(|(entity, ..)| *entity);
+
+    // Packed order: strand by strand along each strand, then loose particles.
+    let mut order: Vec<Entity> = Vec::with_capacity(valid.len());
+    let mut index: EntityHashMap<u32> = EntityHashMap::default();
+    let mut push = |entity: Entity, order: &mut Vec<Entity>| {
+        index.entry(entity).or_insert_with(|| {
+            order.push(entity);
+            (order.len() - 1) as u32
+        });
+    };
+    for (_, strand, ..) in &strands {
+        for &p in &strand.particles {
+            push(p, &mut order);
+        }
+    }
+    let mut loose: Vec<Entity> = valid.keys().copied().collect();
+    loose.sort();
+    for p in loose {
+        push(p, &mut order);
+    }
+
+    let mut edges = Vec::new();
+    let mut bends = Vec::new();
+    let mut records = Vec::with_capacity(strands.len());
+    for (strand_index, (entity, strand, material, kind)) in strands.iter().enumerate() {
+        let first_edge = edges.len();
+        let packed: Vec<u32> = strand.particles.iter().map(|p| index[p]).collect();
+        let pinned = |i: u32| valid[&order[i as usize]];
+        let n = packed.len();
+        for (k, &rest_length) in strand.rest_lengths.iter().enumerate() {
+            let (a, b) = (packed[k], packed[(k + 1) % n]);
+            let is_static = pinned(a) && pinned(b);
+            edges.push(Edge {
+                a,
+                b,
+                rest_length,
+                strand: strand_index as u32,
+                is_static,
+                constrained: false,
+                spring: !is_static && material.stretch_stiffness > 0.0,
+                stiffness: material.stretch_stiffness,
+                damping: material.stretch_damping,
+            });
+        }
+        let bendable = material.bending_stiffness > 0.0 || material.bending_damping > 0.0;
+        let bending_vertices = if bendable {
+            bend_count(n, strand.closed)
+        } else {
+            0
+        };
+        for j in 0..bending_vertices {
+            let s = if strand.closed { j } else { j + 1 };
+            let prev = (s + n - 1) % n;
+            let (a, sv, b) = (packed[prev], packed[s], packed[(s + 1) % n]);
+            if pinned(a) && pinned(sv) && pinned(b) {
+                continue;
+            }
+            // Edge v joins vertices v and v + 1, so the edges at s are prev and s.
+            let voronoi = 0.5 * (strand.rest_lengths[prev] + strand.rest_lengths[s]);
+            bends.push(Bend {
+                a,
+                s: sv,
+                b,
+                rest_angle: strand.rest_angles.get(j).copied().unwrap_or(0.0),
+                stiffness: material.bending_stiffness / voronoi,
+                damping: material.bending_damping,
+            });
+        }
+        records.push(StrandRecord {
+            entity: *entity,
+            kind: *kind,
+            edges: first_edge..edges.len(),
+            closed: strand.closed,
+        });
+    }
+
+    let mut solver_indices = world.query_filtered::<(Entity, &mut SolverIndex), With<Particle>>();
+    for (entity, mut solver_index) in solver_indices.iter_mut(world) {
+        let new = index
+            .get(&entity)
+            .map_or(SolverIndex::NONE, |&i| SolverIndex(i));
+        solver_index.set_if_neq(new);
+    }
+    world.resource_mut::<ParticleState>().resize(order);
+    world.insert_resource(problems);
+
+    let mut topology = world.resource_mut::<Topology>();
+    topology.version += 1;
+    topology.index = index;
+    topology.edges = edges;
+    topology.bends = bends;
+    topology.strands = records;
+    topology.default_material = Some(default_material);
+    topology.dirty = false;
+}
+
+/// Why a strand cannot be simulated, if it cannot. `valid` holds the particles that can.
+fn strand_problem(strand: &Strand, valid: &EntityHashMap<bool>) -> Option<String> {
+    let n = strand.particles.len();
+    let min = if strand.closed { 3 } else { 2 };
+    if n < min {
+        let kind = if strand.closed { "a closed" } else { "an open" };
+        return Some(format!(
+            "it has {n} particle(s); {kind} strand needs at least {min}"
+        ));
+    }
+    let edges = edge_count(n, strand.closed);
+    if strand.rest_lengths.len() != edges {
+        return Some(format!(
+            "it has {} rest lengths for {edges} edges",
+            strand.rest_lengths.len()
+        ));
+    }
+    if let Some((k, length)) = strand
+        .rest_lengths
+        .iter()
+        .enumerate()
+        .find(|(_, l)| !(l.is_finite() && **l > 0.0))
+    {
+        return Some(format!(
+            "rest length of edge {k} is {length}; it must be positive and finite"
+        ));
+    }
+    let bends = bend_count(n, strand.closed);
+    if !strand.rest_angles.is_empty() && strand.rest_angles.len() != bends {
+        return Some(format!(
+            "it has {} rest angles for {bends} bending vertices",
+            strand.rest_angles.len()
+        ));
+    }
+    if let Some(angle) = strand.rest_angles.iter().find(|a| !a.is_finite()) {
+        return Some(format!("rest angle {angle} is not finite"));
+    }
+    if let Some((i, p)) = strand
+        .particles
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !valid.contains_key(*p))
+    {
+        return Some(format!(
+            "vertex {i} ({p}) is not a particle that can be simulated"
+        ));
+    }
+    if let Some(k) = (0..edges).find(|&k| {
+        let (a, b) = strand.edge(k);
+        a == b
+    }) {
+        return Some(format!(
+            "edge {k} joins particle {} to itself",
+            strand.particles[k]
+        ));
+    }
+    None
+}
+
+/// Split every strand that lists a despawned particle into the runs of particles that
+/// still exist, so that no strand is left referencing a dead entity.
+fn split_strands_with_missing_particles(world: &mut World) {
+    let mut strands = world.query::<(
+        Entity,
+        &Strand,
+        Option<&StrandKind>,
+        Option<&StrandMaterial>,
+    )>();
+    let broken: Vec<_> = strands
+        .iter(world)
+        .filter(|(_, strand, ..)| {
+            strand
+                .particles
+                .iter()
+                .any(|&p| world.get_entity(p).is_err())
+        })
+        .map(|(entity, strand, kind, material)| {
+            (entity, strand.clone(), kind.copied(), material.copied())
+        })
+        .collect();
+
+    for (entity, strand, kind, material) in broken {
+        let alive: EntityHashSet = strand
+            .particles
+            .iter()
+            .copied()
+            .filter(|&p| world.get_entity(p).is_ok())
+            .collect();
+        let exists = |p: Entity| alive.contains(&p);
+        let missing: Vec<Entity> = strand
+            .particles
+            .iter()
+            .copied()
+            .filter(|&p| !exists(p))
+            .collect();
+        let pieces = split_around(&strand, exists);
+        let message = format!(
+            "strand referenced despawned particle(s) {missing:?}; split into {} strand(s)",
+            pieces.len()
+        );
+        world
+            .get_resource_or_insert_with(InputProblems::default)
+            .report(entity, message);
+
+        let owned_by = |world: &World, p: Entity| {
+            world
+                .get::<StrandOf>(p)
+                .is_some_and(|owner| owner.0 == entity)
+        };
+        let Some((first, rest)) = pieces.split_first() else {
+            // Nothing left to join: free the survivors so they outlive the strand.
+            for &p in &strand.particles {
+                if exists(p) && owned_by(world, p) {
+                    world.entity_mut(p).remove::<StrandOf>();
+                }
+            }
+            world.entity_mut(entity).despawn();
+            continue;
+        };
+        for piece in rest {
+            let mut spawned = world.spawn((piece.clone(), kind.unwrap_or_default()));
+            if let Some(material) = material {
+                spawned.insert(material);
+            }
+            let new = spawned.id();
+            for &p in &piece.particles {
+                if owned_by(world, p) {
+                    world.entity_mut(p).insert(StrandOf(new));
+                }
+            }
+        }
+        world.entity_mut(entity).insert(first.clone());
+    }
+}
+
+/// The runs of consecutive vertices for which `keep` holds, as open strands of at
+/// least two particles, with their rest lengths and rest angles.
+pub fn split_around(strand: &Strand, keep: impl Fn(Entity) -> bool) -> Vec<Strand> {
+    let n = strand.particles.len();
+    let kept: Vec<bool> = strand.particles.iter().map(|&p| keep(p)).collect();
+    let Some(gap) = kept.iter().position(|k| !k) else {
+        return vec![strand.clone()];
+    };
+    // Walk the vertices once, starting after a gap when the strand is a loop so that
+    // the run that wraps around the end is not cut in two.
+    let start = if strand.closed { gap + 1 } else { 0 };
+    let walk: Vec<usize> = (0..n).map(|i| (start + i) % n).collect();
+    let angle_at = |v: usize| -> Option<f64> {
+        if strand.rest_angles.is_empty() {
+            None
+        } else if strand.closed {
+            Some(strand.rest_angles[v])
+        } else {
+            (v >= 1 && v + 1 < n).then(|| strand.rest_angles[v - 1])
+        }
+    };
+    let mut pieces = Vec::new();
+    for run in walk.split(|&v| !kept[v]) {
+        if run.len() < 2 {
+            continue;
+        }
+        pieces.push(Strand {
+            particles: run.iter().map(|&v| strand.particles[v]).collect(),
+            // Edge (v, v + 1) has index v in both open and closed strands.
+            rest_lengths: run.windows(2).map(|w| strand.rest_lengths[w[0]]).collect(),
+            rest_angles: if strand.rest_angles.is_empty() {
+                Vec::new()
+            } else {
+                run[1..run.len() - 1]
+                    .iter()
+                    .map(|&v| angle_at(v).unwrap_or(0.0))
+                    .collect()
+            },
+            closed: false,
+        });
+    }
+    pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entities(n: u32) -> Vec<Entity> {
+        (0..n)
+            .map(|i| Entity::from_raw_u32(i + 1).unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn open_strand_splits_around_a_missing_vertex() {
+        let particles = entities(5);
+        let strand = Strand {
+            particles: particles.clone(),
+            rest_lengths: vec![1.0, 2.0, 3.0, 4.0],
+            rest_angles: vec![0.1, 0.2, 0.3],
+            closed: false,
+        };
+        let gone = particles[2];
+        let pieces = split_around(&strand, |p| p != gone);
+        assert_eq!(pieces.len(), 2);
+        assert_eq!(pieces[0].particles, particles[0..2].to_vec());
+        assert_eq!(pieces[0].rest_lengths, vec![1.0]);
+        assert!(pieces[0].rest_angles.is_empty());
+        assert_eq!(pieces[1].particles, particles[3..5].to_vec());
+        assert_eq!(pieces[1].rest_lengths, vec![4.0]);
+    }
+
+    #[test]
+    fn loop_opens_at_a_missing_vertex_without_cutting_the_wrap() {
+        let particles = entities(5);
+        let strand = Strand {
+            particles: particles.clone(),
+            rest_lengths: vec![1.0, 2.0, 3.0, 4.0, 5.0],
+            rest_angles: vec![0.0, 0.1, 0.2, 0.3, 0.4],
+            closed: true,
+        };
+        let gone = particles[1];
+        let pieces = split_around(&strand, |p| p != gone);
+        assert_eq!(pieces.len(), 1);
+        let piece = &pieces[0];
+        assert_eq!(
+            piece.particles,
+            vec![particles[2], particles[3], particles[4], particles[0]]
+        );
+        assert_eq!(piece.rest_lengths, vec![3.0, 4.0, 5.0]);
+        assert_eq!(piece.rest_angles, vec![0.3, 0.4]);
+        assert!(!piece.closed);
+    }
+}

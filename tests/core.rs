@@ -1,0 +1,321 @@
+//! The core: data model, step pipeline, forces and integration, headless on
+//! `MinimalPlugins`.
+
+mod common;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_strands::prelude::*;
+use common::*;
+
+fn spawn_particle(app: &mut App, x: DVec2, v: DVec2) -> Entity {
+    app.world_mut()
+        .spawn((Particle, Position(x), Velocity(v)))
+        .id()
+}
+
+#[test]
+fn free_fall_follows_symplectic_euler() {
+    let mut app = app();
+    let dt = 1.0 / 3000.0;
+    set_step(&mut app, dt, 1);
+    let (x0, v0) = (DVec2::new(0.2, 0.9), DVec2::new(0.3, 1.0));
+    let p = spawn_particle(&mut app, x0, v0);
+    let g = app.world().resource::<StrandsConfig>().gravity;
+    for n in 1..=600u32 {
+        tick(&mut app);
+        let n = n as f64;
+        // v_n = v0 + n g dt; x_n = x0 + dt Σ v_k = x0 + n dt v0 + n(n+1)/2 g dt².
+        let v = v0 + n * dt * g;
+        let x = x0 + n * dt * v0 + 0.5 * n * (n + 1.0) * dt * dt * g;
+        assert!(velocity(&app, p).distance(v) < 1e-12, "step {n}");
+        assert!(position(&app, p).distance(x) < 1e-12, "step {n}");
+    }
+}
+
+#[test]
+fn pinned_particle_stays_put_and_driven_one_moves_kinematically() {
+    let mut app = app();
+    let rope = StrandBuilder::line(DVec2::new(0.5, 0.9), DVec2::X, 10, 0.02)
+        .pin_first()
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let driven = app
+        .world_mut()
+        .spawn((Particle, Pinned, Position(DVec2::ZERO), Velocity(DVec2::X)))
+        .id();
+    let anchor = strand_particles(&app, rope)[0];
+    ticks(&mut app, 50);
+    assert_eq!(position(&app, anchor), DVec2::new(0.5, 0.9));
+    assert_eq!(velocity(&app, anchor), DVec2::ZERO);
+    // 50 ticks of 1/100 s at unit speed, untouched by gravity.
+    assert!((position(&app, driven) - DVec2::new(0.5, 0.0)).length() < 1e-12);
+    // The free end swings.
+    let tip = *strand_particles(&app, rope).last().unwrap();
+    assert!(position(&app, tip).distance(DVec2::new(0.68, 0.9)) > 0.05);
+}
+
+#[test]
+fn spring_pair_oscillates_with_the_expected_period() {
+    let mut app = app();
+    let dt = 1e-4;
+    set_step(&mut app, dt, 1);
+    {
+        let mut config = app.world_mut().resource_mut::<StrandsConfig>();
+        config.gravity = DVec2::ZERO;
+    }
+    let (k, rest, m) = (50.0, 0.1, 0.5);
+    let material = StrandMaterial {
+        stretch_stiffness: k,
+        stretch_damping: 0.0,
+        bending_stiffness: 0.0,
+        bending_damping: 0.0,
+    };
+    // Start stretched by 10 %.
+    let pair = StrandBuilder::polyline([DVec2::ZERO, DVec2::new(1.1 * rest, 0.0)])
+        .rest_lengths(vec![rest])
+        .mass(m)
+        .material(material)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let [a, b] = strand_particles(&app, pair)[..] else {
+        unreachable!()
+    };
+    // Linear stiffness k/L on the reduced mass m/2; symplectic Euler turns the phase
+    // by θ per step with cos θ = 1 − (ω dt)²/2.
+    let omega = ((k / rest) / (m / 2.0)).sqrt();
+    let theta = (1.0 - (omega * dt).powi(2) / 2.0).acos();
+    let expected = std::f64::consts::TAU / theta * dt;
+
+    let mut crossings = Vec::new();
+    let mut previous = 0.1 * rest;
+    for step in 1..=20_000 {
+        tick(&mut app);
+        let stretch = position(&app, a).distance(position(&app, b)) - rest;
+        if previous > 0.0 && stretch <= 0.0 {
+            // Interpolate the downward zero crossing.
+            crossings.push((step as f64 - stretch / (stretch - previous)) * dt);
+        }
+        previous = stretch;
+    }
+    assert!(crossings.len() >= 5, "too few periods: {crossings:?}");
+    let periods: Vec<f64> = crossings.windows(2).map(|w| w[1] - w[0]).collect();
+    for period in periods {
+        assert!(
+            (period - expected).abs() < 2.0 * dt,
+            "period {period} vs {expected}"
+        );
+    }
+    // The momentum of the pair stays zero.
+    let state = app.world().resource::<ParticleState>();
+    assert!(state.linear_momentum().length() < 1e-12);
+}
+
+#[test]
+fn damping_decays_kinetic_energy_geometrically() {
+    let mut app = app();
+    let dt = 1e-3;
+    set_step(&mut app, dt, 1);
+    let c = 2.0;
+    {
+        let mut config = app.world_mut().resource_mut::<StrandsConfig>();
+        config.gravity = DVec2::ZERO;
+        config.damping = c;
+    }
+    for i in 0..5 {
+        let v = DVec2::new(i as f64 - 2.0, 1.0 + i as f64);
+        spawn_particle(&mut app, DVec2::new(0.1 * i as f64, 0.5), v);
+    }
+    tick(&mut app);
+    let mut energy = app.world().resource::<ParticleState>().kinetic_energy();
+    for _ in 0..200 {
+        tick(&mut app);
+        let next = app.world().resource::<ParticleState>().kinetic_energy();
+        // v ← (1 − c dt) v, so the energy shrinks by (1 − c dt)² each step.
+        let expected = energy * (1.0 - c * dt).powi(2);
+        assert!((next - expected).abs() <= 1e-12 * energy);
+        energy = next;
+    }
+}
+
+fn spawn_rope_scene(app: &mut App) -> Entity {
+    StrandBuilder::line(DVec2::new(0.2, 0.8), DVec2::new(1.0, 0.3), 25, 0.02)
+        .pin_first()
+        .spawn_in(app.world_mut())
+        .unwrap()
+}
+
+#[test]
+fn substeps_equal_the_same_count_of_single_steps() {
+    let mut grouped = app();
+    let mut single = app();
+    set_step(&mut grouped, 1.0 / 3000.0, 30);
+    set_step(&mut single, 1.0 / 3000.0, 1);
+    let a = spawn_rope_scene(&mut grouped);
+    let b = spawn_rope_scene(&mut single);
+    for _ in 0..10 {
+        tick(&mut grouped);
+        ticks(&mut single, 30);
+    }
+    assert_eq!(strand_state(&grouped, a), strand_state(&single, b));
+    assert_eq!(
+        grouped.world().resource::<SimulationClock>().steps,
+        single.world().resource::<SimulationClock>().steps
+    );
+}
+
+#[test]
+fn spawning_and_despawning_strands_mid_run_keeps_other_state() {
+    let mut changed = app();
+    let mut reference = app();
+    let kept = spawn_rope_scene(&mut changed);
+    let kept_reference = spawn_rope_scene(&mut reference);
+    let doomed = StrandBuilder::line(DVec2::new(0.6, 0.2), DVec2::X, 8, 0.03)
+        .spawn_in(changed.world_mut())
+        .unwrap();
+    let doomed_particles = strand_particles(&changed, doomed);
+    ticks(&mut changed, 5);
+    ticks(&mut reference, 5);
+
+    changed.world_mut().despawn(doomed);
+    StrandBuilder::line(DVec2::new(0.1, 0.3), DVec2::Y, 12, 0.01)
+        .spawn_in(changed.world_mut())
+        .unwrap();
+    for _ in 0..5 {
+        tick(&mut changed);
+        tick(&mut reference);
+        assert_eq!(
+            strand_state(&changed, kept),
+            strand_state(&reference, kept_reference)
+        );
+    }
+    // The despawned strand took its particles with it.
+    for p in doomed_particles {
+        assert!(changed.world().get_entity(p).is_err());
+    }
+    let metrics = changed.world().resource::<StrandMetrics>();
+    assert_eq!(metrics.strands, 2);
+    assert_eq!(metrics.particles, 25 + 12);
+}
+
+#[test]
+fn a_particle_with_bad_mass_is_left_out_with_a_message() {
+    let mut app = app();
+    let bad = app
+        .world_mut()
+        .spawn((Particle, Position(DVec2::new(0.5, 0.5)), Mass(-1.0)))
+        .id();
+    let good = spawn_particle(&mut app, DVec2::new(0.3, 0.5), DVec2::ZERO);
+    ticks(&mut app, 3);
+    assert_eq!(position(&app, bad), DVec2::new(0.5, 0.5));
+    assert!(position(&app, good).y < 0.5);
+    let problems = app.world().resource::<InputProblems>();
+    assert!(problems.concerns(bad));
+    assert!(
+        problems.entries[0].problem.contains("mass -1"),
+        "{:?}",
+        problems.entries
+    );
+}
+
+#[test]
+fn a_nan_written_between_ticks_is_refused_and_the_last_state_kept() {
+    let mut app = app();
+    let p = spawn_particle(&mut app, DVec2::new(0.5, 0.5), DVec2::ZERO);
+    let twin = spawn_particle(&mut app, DVec2::new(0.7, 0.5), DVec2::ZERO);
+    ticks(&mut app, 2);
+    app.world_mut().get_mut::<Position>(p).unwrap().0.x = f64::NAN;
+    ticks(&mut app, 2);
+    // The packed state kept the last good position and stepped on from it, exactly as
+    // its untouched twin did...
+    assert_eq!(
+        position(&app, p) + DVec2::new(0.2, 0.0),
+        position(&app, twin)
+    );
+    assert_eq!(velocity(&app, p), velocity(&app, twin));
+    // ...and the problem was reported; the next rebuild leaves the particle alone.
+    let problems = app.world().resource::<InputProblems>();
+    assert!(
+        problems
+            .entries
+            .iter()
+            .any(|e| e.entity == p && e.problem.contains("NaN"))
+    );
+}
+
+#[test]
+fn a_strand_referencing_a_despawned_particle_is_split_with_a_message() {
+    let mut app = app();
+    let rope = StrandBuilder::line(DVec2::new(0.1, 0.5), DVec2::X, 7, 0.05)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let particles = strand_particles(&app, rope);
+    tick(&mut app);
+    app.world_mut().despawn(particles[3]);
+    tick(&mut app);
+
+    let mut strands = app.world_mut().query::<&Strand>();
+    let mut pieces: Vec<Vec<Entity>> = strands
+        .iter(app.world())
+        .map(|s| s.particles.clone())
+        .collect();
+    assert_eq!(pieces.len(), 2);
+    assert!(pieces.contains(&particles[0..3].to_vec()));
+    assert!(pieces.contains(&particles[4..7].to_vec()));
+    for strand in strands.iter(app.world()) {
+        assert!(
+            strand
+                .particles
+                .iter()
+                .all(|&p| app.world().get_entity(p).is_ok())
+        );
+        assert_eq!(strand.rest_lengths.len(), 2);
+    }
+    let problems = app.world().resource::<InputProblems>();
+    assert!(problems.entries.iter().any(|e| e.entity == rope
+        && e.problem.contains("despawned")
+        && e.problem.contains("split into 2")));
+    assert_eq!(app.world().resource::<StrandMetrics>().edges, 4);
+}
+
+#[test]
+fn an_invalid_strand_component_is_left_out_with_a_message() {
+    let mut app = app();
+    let a = spawn_particle(&mut app, DVec2::new(0.1, 0.5), DVec2::ZERO);
+    let b = spawn_particle(&mut app, DVec2::new(0.2, 0.5), DVec2::ZERO);
+    let one = app
+        .world_mut()
+        .spawn(Strand {
+            particles: vec![a],
+            rest_lengths: vec![],
+            rest_angles: vec![],
+            closed: false,
+        })
+        .id();
+    let negative = app
+        .world_mut()
+        .spawn(Strand {
+            particles: vec![a, b],
+            rest_lengths: vec![-0.1],
+            rest_angles: vec![],
+            closed: false,
+        })
+        .id();
+    tick(&mut app);
+    let problems = app.world().resource::<InputProblems>();
+    let message = |e: Entity| {
+        problems
+            .entries
+            .iter()
+            .find(|p| p.entity == e)
+            .map(|p| p.problem.clone())
+            .unwrap_or_default()
+    };
+    assert!(
+        message(one).contains("needs at least 2"),
+        "{}",
+        message(one)
+    );
+    assert!(message(negative).contains("rest length of edge 0 is -0.1"));
+    assert_eq!(app.world().resource::<StrandMetrics>().strands, 0);
+}
