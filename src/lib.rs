@@ -45,7 +45,7 @@ use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 
 use config::StrandsConfig;
-use constraints::ConstraintConfig;
+use constraints::ConstraintsPlugin;
 use metrics::StrandMetrics;
 use schedule::{SchedulePlugin, SimulationClock};
 use state::ParticleState;
@@ -54,6 +54,7 @@ use topology::{InputProblems, Topology};
 /// Everything most users need.
 pub mod prelude {
     pub use crate::config::StrandsConfig;
+    pub use crate::constraints::{ConstraintConfig, ConstraintsPlugin, SolverKind};
     pub use crate::metrics::StrandMetrics;
     pub use crate::particle::{ExternalForce, Mass, Particle, Pinned, Position, Velocity};
     pub use crate::schedule::{SimulationClock, StepSet, StrandsStep, StrandsTick, TickSet};
@@ -96,9 +97,11 @@ impl StrandsPlugin {
 
 impl PluginGroup for StrandsPlugin {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(StrandsCorePlugin {
-            driver: self.driver,
-        })
+        PluginGroupBuilder::start::<Self>()
+            .add(StrandsCorePlugin {
+                driver: self.driver,
+            })
+            .add(ConstraintsPlugin)
     }
 }
 
@@ -117,7 +120,6 @@ impl Plugin for StrandsCorePlugin {
             .init_resource::<InputProblems>()
             .init_resource::<SimulationClock>()
             .init_resource::<StrandMetrics>()
-            .init_resource::<ConstraintConfig>()
             .register_type::<StrandsConfig>()
             .register_type::<SimulationClock>()
             .register_type::<particle::Particle>()

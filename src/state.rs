@@ -98,7 +98,7 @@ pub(crate) fn particle_problem(
         Some(format!("position {position:?} is not finite"))
     } else if !velocity.is_finite() {
         Some(format!("velocity {velocity:?} is not finite"))
-    } else if !pinned && !(mass.is_finite() && mass > 0.0) {
+    } else if !(pinned || mass.is_finite() && mass > 0.0) {
         Some(format!("mass {mass} must be positive and finite"))
     } else {
         None

@@ -80,6 +80,8 @@ pub struct Topology {
     dirty: bool,
     /// Packed index of every simulated particle.
     pub index: EntityHashMap<u32>,
+    /// Whether each packed particle is pinned.
+    pub pinned: Vec<bool>,
     /// All edges, strand by strand.
     pub edges: Vec<Edge>,
     /// All bending elements.
@@ -147,11 +149,13 @@ impl InputProblems {
     }
 }
 
+type EditedStrand = Or<(Changed<Strand>, Changed<StrandMaterial>)>;
+
 /// Mark the topology dirty when a strand was edited in place.
 pub fn detect_strand_edits(
     mut topology: ResMut<Topology>,
     config: Res<StrandsConfig>,
-    edited: Query<(), Or<(Changed<Strand>, Changed<StrandMaterial>)>>,
+    edited: Query<(), EditedStrand>,
 ) {
     if !edited.is_empty() || topology.default_material != Some(config.material) {
         topology.dirty = true;
@@ -290,12 +294,14 @@ pub fn rebuild_topology(world: &mut World) {
             .map_or(SolverIndex::NONE, |&i| SolverIndex(i));
         solver_index.set_if_neq(new);
     }
+    let pinned = order.iter().map(|e| valid[e]).collect();
     world.resource_mut::<ParticleState>().resize(order);
     world.insert_resource(problems);
 
     let mut topology = world.resource_mut::<Topology>();
     topology.version += 1;
     topology.index = index;
+    topology.pinned = pinned;
     topology.edges = edges;
     topology.bends = bends;
     topology.strands = records;

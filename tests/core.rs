@@ -60,10 +60,8 @@ fn spring_pair_oscillates_with_the_expected_period() {
     let mut app = app();
     let dt = 1e-4;
     set_step(&mut app, dt, 1);
-    {
-        let mut config = app.world_mut().resource_mut::<StrandsConfig>();
-        config.gravity = DVec2::ZERO;
-    }
+    app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
+    app.world_mut().resource_mut::<ConstraintConfig>().solver = SolverKind::Springs;
     let (k, rest, m) = (50.0, 0.1, 0.5);
     let material = StrandMaterial {
         stretch_stiffness: k,
@@ -255,7 +253,7 @@ fn a_strand_referencing_a_despawned_particle_is_split_with_a_message() {
     tick(&mut app);
 
     let mut strands = app.world_mut().query::<&Strand>();
-    let mut pieces: Vec<Vec<Entity>> = strands
+    let pieces: Vec<Vec<Entity>> = strands
         .iter(app.world())
         .map(|s| s.particles.clone())
         .collect();
