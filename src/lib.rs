@@ -25,6 +25,7 @@
 //! # let _ = rope;
 //! ```
 
+pub mod collision;
 pub mod config;
 pub mod constraints;
 pub mod forces;
@@ -44,6 +45,7 @@ use bevy::app::PluginGroupBuilder;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 
+use collision::CollisionPlugin;
 use config::StrandsConfig;
 use constraints::ConstraintsPlugin;
 use metrics::StrandMetrics;
@@ -53,6 +55,7 @@ use topology::{InputProblems, Topology};
 
 /// Everything most users need.
 pub mod prelude {
+    pub use crate::collision::{CollisionConfig, CollisionPlugin};
     pub use crate::config::StrandsConfig;
     pub use crate::constraints::{ConstraintConfig, ConstraintsPlugin, SolverKind};
     pub use crate::metrics::StrandMetrics;
@@ -102,6 +105,7 @@ impl PluginGroup for StrandsPlugin {
                 driver: self.driver,
             })
             .add(ConstraintsPlugin)
+            .add(CollisionPlugin)
     }
 }
 

@@ -64,14 +64,21 @@ pub struct StrandMetrics {
     pub edges: usize,
     /// Edges kept at rest length by the constraint solver.
     pub constrained_edges: usize,
-    /// Constraint projection iterations per island solve.
+    /// Constraint projection iterations per island solve (the Constrain stage).
     pub projection: IterationStats,
+    /// Re-projections after contact (DESIGN §7).
+    pub contact_projection: IterationStats,
     /// Collision impulses applied.
     pub collisions: u64,
     /// Collision impulses applied in the latest step.
     pub collisions_last_step: u64,
     /// Steps that needed the collision fail-safe.
     pub failsafe_steps: u64,
+    /// Collisions the fail-safe could not resolve (only kinematic particles driven
+    /// into each other can cause these).
+    pub unresolved_collisions: u64,
+    /// Intersecting edge pairs at the end of the latest checked step.
+    pub crossing_pairs_last_step: usize,
     /// Step ends at which two edges sharing no particle intersected; `None` when not
     /// checked.
     pub edge_crossings: Option<u64>,

@@ -37,6 +37,15 @@ pub struct Report {
     pub projection_iterations_max: u32,
     /// Island solves that stopped at the iteration cap.
     pub projection_capped_solves: u64,
+    /// Re-projections of islands in contact (DESIGN §7): solves, mean and most
+    /// iterations, and solves that stopped at the cap.
+    pub contact_projection_solves: u64,
+    /// Mean iterations of a re-projection in contact.
+    pub contact_projection_iterations_mean: f64,
+    /// Most iterations of a re-projection in contact.
+    pub contact_projection_iterations_max: u32,
+    /// Re-projections in contact that stopped at the cap.
+    pub contact_projection_capped_solves: u64,
     /// Wall-clock seconds of the run's ticks.
     pub wall_seconds: f64,
     /// Particles × steps per wall-clock second.
@@ -84,6 +93,16 @@ impl Report {
                     self.projection_iterations_mean,
                     self.projection_iterations_max,
                     self.projection_capped_solves
+                ),
+            ),
+            (
+                "contact_projection",
+                format!(
+                    "{} solves, mean {:.2}, max {}, capped {}",
+                    self.contact_projection_solves,
+                    self.contact_projection_iterations_mean,
+                    self.contact_projection_iterations_max,
+                    self.contact_projection_capped_solves
                 ),
             ),
             ("wall_seconds", format!("{:.3}", self.wall_seconds)),

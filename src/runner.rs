@@ -8,6 +8,7 @@ use bevy::prelude::*;
 use thiserror::Error;
 
 use crate::StrandsPlugin;
+use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
 use crate::constraints::{ConstraintConfig, SolverKind};
 use crate::metrics::StrandMetrics;
@@ -96,6 +97,10 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
     let scene = load_scene(options)?;
     let mut app = headless_app(&scene)?;
     let world = app.world_mut();
+    world.resource_mut::<CollisionConfig>().check_crossings = options.check_crossings;
+    if options.check_crossings {
+        world.resource_mut::<StrandMetrics>().edge_crossings = Some(0);
+    }
 
     let total_steps = (scene.duration / scene.dt).round().max(1.0) as u64;
     let mut particle_steps = 0u64;
@@ -128,7 +133,13 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         );
     }
     if metrics.edge_crossings.is_none() {
-        notes.push("edge crossings were not checked".to_string());
+        notes.push("edge crossings were not checked (--no-check)".to_string());
+    }
+    if metrics.unresolved_collisions > 0 {
+        notes.push(format!(
+            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other)",
+            metrics.unresolved_collisions
+        ));
     }
     let input_problems = world
         .resource::<InputProblems>()
@@ -153,6 +164,10 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         projection_iterations_mean: metrics.projection.mean(),
         projection_iterations_max: metrics.projection.max,
         projection_capped_solves: metrics.projection.capped,
+        contact_projection_solves: metrics.contact_projection.solves,
+        contact_projection_iterations_mean: metrics.contact_projection.mean(),
+        contact_projection_iterations_max: metrics.contact_projection.max,
+        contact_projection_capped_solves: metrics.contact_projection.capped,
         wall_seconds,
         particle_steps_per_second: if wall_seconds > 0.0 {
             particle_steps as f64 / wall_seconds

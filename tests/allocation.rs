@@ -55,8 +55,9 @@ fn steady_state_steps_and_ticks_allocate_nothing() {
         std::hint::black_box(Vec::<u8>::with_capacity(16));
     });
     assert_eq!(probe, 1);
-    // Warm up: the first ticks build the topology, the islands and the schedules.
-    for _ in 0..5 {
+    // Warm up through first contact: the first ticks build the topology, the islands
+    // and the schedules; the first contacts size the collision buffers.
+    for _ in 0..100 {
         world.run_schedule(StrandsTick);
     }
     let steps = allocations_during(|| {

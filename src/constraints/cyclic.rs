@@ -4,22 +4,63 @@
 //! edge to its first. Writing `A = T + u vᵀ`, with `T` tridiagonal, costs two Thomas
 //! solves (`T y = b`, `T z = u`) and one correction.
 
-use super::tridiagonal::{SingularPivot, solve_tridiagonal};
+use super::tridiagonal::{SingularPivot, TridiagonalFactor};
 
-/// Buffers for [`solve_cyclic_tridiagonal`], each of at least `n` values.
+/// A factored cyclic tridiagonal matrix, to solve many right-hand sides cheaply.
 #[derive(Clone, Debug, Default)]
-pub struct CyclicScratch {
+pub struct CyclicFactor {
+    inner: TridiagonalFactor,
     diagonal: Vec<f64>,
     correction: Vec<f64>,
-    thomas: Vec<f64>,
+    beta_over_gamma: f64,
+    denominator: f64,
 }
 
-impl CyclicScratch {
-    /// Make room for systems of `n` unknowns (allocates only when growing).
-    pub fn reserve(&mut self, n: usize) {
-        for buffer in [&mut self.diagonal, &mut self.correction, &mut self.thomas] {
-            if buffer.len() < n {
-                buffer.resize(n, 0.0);
+impl CyclicFactor {
+    /// Factor `A` (n ≥ 3; rows as in [`solve_cyclic_tridiagonal`]).
+    pub fn factor(
+        &mut self,
+        lower: &[f64],
+        diagonal: &[f64],
+        upper: &[f64],
+    ) -> Result<(), SingularPivot> {
+        let n = diagonal.len();
+        assert!(n >= 3, "a cyclic system needs at least 3 unknowns");
+        let (alpha, beta) = (upper[n - 1], lower[0]); // A[n−1][0], A[0][n−1]
+        let gamma = -diagonal[0];
+        self.diagonal.clear();
+        self.diagonal.extend_from_slice(diagonal);
+        self.diagonal[0] -= gamma;
+        self.diagonal[n - 1] -= alpha * beta / gamma;
+        self.inner.factor(lower, &self.diagonal, upper)?;
+        // z = T⁻¹ u with u = (γ, 0, …, 0, α).
+        self.correction.clear();
+        self.correction.resize(n, 0.0);
+        self.correction[0] = gamma;
+        self.correction[n - 1] = alpha;
+        self.inner.solve(&mut self.correction);
+        self.beta_over_gamma = beta / gamma;
+        self.denominator = 1.0 + self.correction[0] + self.beta_over_gamma * self.correction[n - 1];
+        if !(self.denominator.is_finite() && self.denominator != 0.0) {
+            return Err(SingularPivot { row: n - 1 });
+        }
+        Ok(())
+    }
+
+    /// Solve `A x = rhs` in place.
+    pub fn solve(&self, rhs: &mut [f64]) {
+        self.solve_many(rhs, 1);
+    }
+
+    /// Solve `A X = B` in place for `k` right-hand sides stored row by row.
+    pub fn solve_many(&self, columns: &mut [f64], k: usize) {
+        let n = self.inner.len();
+        self.inner.solve_many(columns, k);
+        for c in 0..k {
+            let factor =
+                (columns[c] + self.beta_over_gamma * columns[(n - 1) * k + c]) / self.denominator;
+            for (i, z) in self.correction.iter().enumerate() {
+                columns[i * k + c] -= factor * z;
             }
         }
     }
@@ -29,42 +70,16 @@ impl CyclicScratch {
 ///
 /// Row `i` is `lower[i] x[i−1] + diagonal[i] x[i] + upper[i] x[i+1]` with indices
 /// modulo `n`: `lower[0]` multiplies `x[n−1]` and `upper[n−1]` multiplies `x[0]`.
+/// `factor` is reusable storage; it holds the factorization afterwards.
 pub fn solve_cyclic_tridiagonal(
     lower: &[f64],
     diagonal: &[f64],
     upper: &[f64],
     rhs: &mut [f64],
-    scratch: &mut CyclicScratch,
+    factor: &mut CyclicFactor,
 ) -> Result<(), SingularPivot> {
-    let n = rhs.len();
-    assert!(n >= 3, "a cyclic system needs at least 3 unknowns");
-    scratch.reserve(n);
-    let CyclicScratch {
-        diagonal: modified,
-        correction: z,
-        thomas,
-    } = scratch;
-    let (alpha, beta) = (upper[n - 1], lower[0]); // A[n−1][0], A[0][n−1]
-    let gamma = -diagonal[0];
-    modified[..n].copy_from_slice(&diagonal[..n]);
-    modified[0] -= gamma;
-    modified[n - 1] -= alpha * beta / gamma;
-
-    solve_tridiagonal(lower, &modified[..n], upper, rhs, thomas)?;
-    z[..n].fill(0.0);
-    z[0] = gamma;
-    z[n - 1] = alpha;
-    solve_tridiagonal(lower, &modified[..n], upper, &mut z[..n], thomas)?;
-
-    let numerator = rhs[0] + beta * rhs[n - 1] / gamma;
-    let denominator = 1.0 + z[0] + beta * z[n - 1] / gamma;
-    if !(denominator.is_finite() && denominator != 0.0) {
-        return Err(SingularPivot { row: n - 1 });
-    }
-    let factor = numerator / denominator;
-    for (x, zi) in rhs.iter_mut().zip(&z[..n]) {
-        *x -= factor * zi;
-    }
+    factor.factor(lower, diagonal, upper)?;
+    factor.solve(rhs);
     Ok(())
 }
 
@@ -119,7 +134,7 @@ mod tests {
                 &diagonal,
                 &upper,
                 &mut x,
-                &mut CyclicScratch::default(),
+                &mut CyclicFactor::default(),
             )
             .unwrap();
             let norm = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));

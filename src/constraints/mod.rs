@@ -17,12 +17,15 @@ use std::str::FromStr;
 use bevy::prelude::*;
 
 use crate::config::StrandsConfig;
+use crate::metrics::IterationStats;
 use crate::metrics::{StrandMetrics, count_elements};
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
 use crate::state::ParticleState;
 use crate::topology::{InputProblems, Topology, rebuild_topology};
 use islands::{IslandKind, IslandSet, find_islands};
-use projection::{Chain, ChainScratch, ConstraintDirection, ProjectionSettings, project_chain};
+use projection::{
+    Bodies, Chain, ChainScratch, ConstraintDirection, ContactRow, ProjectionSettings, project_chain,
+};
 
 /// How edges keep their length.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -132,6 +135,8 @@ impl ConstraintConfig {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             direction: self.direction,
+            contact_tolerance: 0.0,
+            max_correction: f64::INFINITY,
         }
     }
 }
@@ -148,6 +153,9 @@ pub struct Islands {
     /// Islands of a kind the configured solver cannot solve (their edges keep stretch
     /// springs).
     pub unsolved: Vec<usize>,
+    island_of_particle: Vec<u32>,
+    touched: Vec<(u32, u32)>,
+    rows: Vec<ContactRow>,
     scratch: ChainScratch,
 }
 
@@ -156,7 +164,139 @@ impl Islands {
     pub fn count(&self, kind: IslandKind) -> usize {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
     }
+
+    /// The solved island a particle belongs to, if any.
+    pub fn island_of(&self, particle: usize) -> Option<usize> {
+        self.island_of_particle
+            .get(particle)
+            .copied()
+            .filter(|&i| i != NO_ISLAND)
+            .map(|i| i as usize)
+    }
+
+    fn chain(&self, island: usize) -> Chain<'_> {
+        let island = &self.set.islands[island];
+        Chain {
+            edges: &self.set.edges[island.edges.clone()],
+            closed: island.kind == IslandKind::Cycle,
+        }
+    }
+
+    /// Project every solved island (the Constrain stage), recording each solve.
+    pub fn project(
+        &mut self,
+        bodies: &mut Bodies,
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) {
+        for slot in 0..self.solved.len() {
+            let i = self.solved[slot];
+            self.project_island(i, bodies, &[], dt, settings, stats);
+        }
+    }
+
+    /// Project again the islands that `contacts` touch, each with its contact rows
+    /// (DESIGN §7): Gauss–Seidel sweeps over those islands, each solved exactly with
+    /// the other sides of its contacts frozen, until no contact falls short by more than
+    /// the settings' contact tolerance or [`CONTACT_SWEEPS`] are done. Returns the
+    /// largest shortfall left, as a speed.
+    pub fn project_with_contacts(
+        &mut self,
+        bodies: &mut Bodies,
+        contacts: &[ContactRow],
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) -> f64 {
+        let tolerance = settings.contact_tolerance / dt;
+        // Which islands each contact touches, grouped by island.
+        self.touched.clear();
+        for (c, row) in contacts.iter().enumerate() {
+            for &p in &row.particles {
+                if let Some(i) = self.island_of(p as usize) {
+                    self.touched.push((i as u32, c as u32));
+                }
+            }
+        }
+        self.touched.sort_unstable();
+        self.touched.dedup();
+        let crosses_islands = contacts.iter().any(|row| {
+            let mut islands = row
+                .particles
+                .iter()
+                .filter_map(|&p| self.island_of(p as usize));
+            islands
+                .next()
+                .is_some_and(|first| islands.any(|i| i != first))
+        });
+        let mut shortfall = contacts
+            .iter()
+            .map(|row| row.target - row.normal_velocity(bodies.velocity))
+            .fold(0.0, f64::max);
+        for _ in 0..CONTACT_SWEEPS {
+            let mut start = 0;
+            while start < self.touched.len() {
+                let island = self.touched[start].0;
+                let end = start
+                    + self.touched[start..]
+                        .iter()
+                        .take_while(|t| t.0 == island)
+                        .count();
+                self.rows.clear();
+                for &(_, c) in &self.touched[start..end] {
+                    self.rows.push(contacts[c as usize]);
+                }
+                let rows = std::mem::take(&mut self.rows);
+                self.project_island(island as usize, bodies, &rows, dt, settings, stats);
+                self.rows = rows;
+                start = end;
+            }
+            shortfall = contacts
+                .iter()
+                .map(|row| row.target - row.normal_velocity(bodies.velocity))
+                .fold(0.0, f64::max);
+            // Each island met its own contacts exactly; only contacts between islands
+            // can have been disturbed since.
+            if !crosses_islands || shortfall <= tolerance {
+                break;
+            }
+        }
+        shortfall
+    }
+
+    fn project_island(
+        &mut self,
+        island: usize,
+        bodies: &mut Bodies,
+        contacts: &[ContactRow],
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let bodies = Bodies {
+            position: bodies.position,
+            velocity: &mut *bodies.velocity,
+            inverse_mass: bodies.inverse_mass,
+        };
+        let outcome = project_chain(
+            self.chain(island),
+            bodies,
+            contacts,
+            dt,
+            settings,
+            &mut scratch,
+        );
+        stats.record(outcome.iterations, outcome.converged);
+        self.scratch = scratch;
+    }
 }
+
+const NO_ISLAND: u32 = u32::MAX;
+
+/// Gauss–Seidel sweeps over the islands in contact, at most, per re-projection.
+pub const CONTACT_SWEEPS: u32 = 8;
 
 /// Islands, the Constrain stage and its settings.
 pub struct ConstraintsPlugin;
@@ -232,6 +372,19 @@ pub fn rebuild_islands(
         }
     }
     islands.scratch.reserve(longest);
+    islands.island_of_particle.clear();
+    islands
+        .island_of_particle
+        .resize(topology.pinned.len(), NO_ISLAND);
+    for &i in &solved {
+        for e in &set.edges[set.islands[i].edges.clone()] {
+            for p in [e.a as usize, e.b as usize] {
+                if !topology.pinned[p] {
+                    islands.island_of_particle[p] = i as u32;
+                }
+            }
+        }
+    }
     islands.set = set;
     islands.solved = solved;
     islands.unsolved = unsolved;
@@ -246,36 +399,21 @@ pub fn solve_constraints(
     mut state: ResMut<ParticleState>,
     mut metrics: ResMut<StrandMetrics>,
 ) {
-    let settings = config.projection();
-    let Islands {
-        set,
-        solved,
-        scratch,
-        ..
-    } = &mut *islands;
     let ParticleState {
         position,
         velocity,
         inverse_mass,
         ..
     } = &mut *state;
-    for &i in solved.iter() {
-        let island = &set.islands[i];
-        let chain = Chain {
-            edges: &set.edges[island.edges.clone()],
-            closed: island.kind == IslandKind::Cycle,
-        };
-        let outcome = project_chain(
-            chain,
-            position,
-            velocity,
-            inverse_mass,
-            step.dt,
-            &settings,
-            scratch,
-        );
-        metrics
-            .projection
-            .record(outcome.iterations, outcome.converged);
-    }
+    let mut bodies = Bodies {
+        position,
+        velocity,
+        inverse_mass,
+    };
+    islands.project(
+        &mut bodies,
+        step.dt,
+        &config.projection(),
+        &mut metrics.projection,
+    );
 }

@@ -57,6 +57,9 @@ pub struct Scene {
     /// Default material of the strands.
     #[serde(default)]
     pub material: MaterialSpec,
+    /// Collision settings.
+    #[serde(default)]
+    pub collisions: CollisionSpec,
     /// An axis-aligned box of pinned walls.
     #[serde(default)]
     pub container: Option<ContainerSpec>,
@@ -118,6 +121,35 @@ impl From<MaterialSpec> for StrandMaterial {
             stretch_damping: m.stretch_damping,
             bending_stiffness: m.bending_stiffness,
             bending_damping: m.bending_damping,
+        }
+    }
+}
+
+/// Collision parameters (see [`CollisionConfig`](crate::collision::CollisionConfig)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct CollisionSpec {
+    /// Whether collisions are processed.
+    pub enabled: bool,
+    /// Thickness: pairs are kept this far apart.
+    pub thickness: f64,
+    /// Coulomb friction coefficient.
+    pub friction: f64,
+    /// Restitution (0: inelastic).
+    pub restitution: f64,
+    /// Alternations of constraint re-projection and collisions after contact.
+    pub contact_passes: u32,
+}
+
+impl Default for CollisionSpec {
+    fn default() -> Self {
+        let c = crate::collision::CollisionConfig::default();
+        Self {
+            enabled: c.enabled,
+            thickness: c.thickness,
+            friction: c.friction,
+            restitution: c.restitution,
+            contact_passes: c.contact_passes,
         }
     }
 }

@@ -4,6 +4,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::{Scene, SceneError, vec2};
+use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
 use crate::constraints::ConstraintConfig;
 use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
@@ -27,6 +28,14 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
         config.material = scene.material.into();
     }
     world.get_resource_or_init::<ConstraintConfig>().solver = solver;
+    {
+        let mut collisions = world.get_resource_or_init::<CollisionConfig>();
+        collisions.enabled = scene.collisions.enabled;
+        collisions.thickness = scene.collisions.thickness;
+        collisions.friction = scene.collisions.friction;
+        collisions.restitution = scene.collisions.restitution;
+        collisions.contact_passes = scene.collisions.contact_passes;
+    }
 
     if let Some(container) = &scene.container {
         container_builder(vec2(container.min), vec2(container.max))

@@ -1,0 +1,157 @@
+//! Criterion benchmarks of the constraint solve: the Thomas kernel per unknown, and
+//! one Constrain stage (every island projected once) on 1000 strands of 100 particles.
+//!
+//! Run with `cargo bench --bench constraints`; results per machine are recorded in
+//! `benches/RESULTS.md`.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use bevy::math::DVec2;
+use bevy_strands::constraints::islands::IslandEdge;
+use bevy_strands::constraints::projection::{
+    Bodies, Chain, ChainScratch, ConstraintDirection, ProjectionSettings, project_chain,
+};
+use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
+use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+
+/// A strand-shaped SPD system: `4|e|²(w_a + w_b)` on the diagonal, `−4 w e·e'` beside.
+fn strand_system(n: usize, rng: &mut StdRng) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let edges: Vec<DVec2> = (0..n)
+        .map(|_| 0.01 * DVec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)))
+        .collect();
+    let diagonal = edges.iter().map(|e| 8.0 * e.length_squared()).collect();
+    let mut lower = vec![0.0; n];
+    let mut upper = vec![0.0; n];
+    for k in 0..n.saturating_sub(1) {
+        upper[k] = -4.0 * edges[k].dot(edges[k + 1]);
+        lower[k + 1] = upper[k];
+    }
+    let rhs = (0..n).map(|_| rng.random_range(-1e-6..1e-6)).collect();
+    (lower, diagonal, upper, rhs)
+}
+
+fn thomas(c: &mut Criterion) {
+    let mut group = c.benchmark_group("thomas_solve");
+    let mut rng = StdRng::seed_from_u64(1);
+    for n in [10usize, 100, 1000, 100_000] {
+        let (lower, diagonal, upper, rhs) = strand_system(n, &mut rng);
+        let mut scratch = vec![0.0; n];
+        group.throughput(Throughput::Elements(n as u64));
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter_batched_ref(
+                || rhs.clone(),
+                |x| solve_tridiagonal(&lower, &diagonal, &upper, black_box(x), &mut scratch),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+/// `strands` wiggly strands of `particles`, with velocities a falling, swinging pile
+/// would have: gravity's kick on top of motion along and across the strand.
+struct Pile {
+    position: Vec<DVec2>,
+    velocity: Vec<DVec2>,
+    inverse_mass: Vec<f64>,
+    edges: Vec<IslandEdge>,
+    chains: Vec<std::ops::Range<usize>>,
+}
+
+fn pile(strands: usize, particles: usize, rng: &mut StdRng) -> Pile {
+    let spacing = 0.01;
+    let mut pile = Pile {
+        position: Vec::new(),
+        velocity: Vec::new(),
+        inverse_mass: Vec::new(),
+        edges: Vec::new(),
+        chains: Vec::new(),
+    };
+    for s in 0..strands {
+        let first = pile.position.len() as u32;
+        let mut x = DVec2::new((s % 40) as f64, (s / 40) as f64);
+        let mut heading: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+        let start = pile.edges.len();
+        for i in 0..particles {
+            if i > 0 {
+                heading += rng.random_range(-0.3..0.3);
+                x += spacing * DVec2::from_angle(heading);
+                let (a, b) = (first + i as u32 - 1, first + i as u32);
+                pile.edges.push(IslandEdge {
+                    a,
+                    b,
+                    rest_length: spacing,
+                    edge: pile.edges.len() as u32,
+                });
+            }
+            pile.position.push(x);
+            pile.velocity.push(DVec2::new(
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+            ));
+            pile.inverse_mass.push(1.0);
+        }
+        pile.chains.push(start..pile.edges.len());
+    }
+    pile
+}
+
+fn constraint_stage(c: &mut Criterion) {
+    let mut group = c.benchmark_group("constraint_stage");
+    let mut rng = StdRng::seed_from_u64(2);
+    let (strands, particles) = (1000, 100);
+    let pile = pile(strands, particles, &mut rng);
+    let settings = ProjectionSettings {
+        tolerance: 1e-12,
+        max_iterations: 20,
+        direction: ConstraintDirection::EndOfStep,
+        contact_tolerance: 0.0,
+        max_correction: f64::INFINITY,
+    };
+    let mut scratch = ChainScratch::default();
+    scratch.reserve(particles);
+    let dt = 1.0 / 3000.0;
+    group.throughput(Throughput::Elements((strands * particles) as u64));
+    group.bench_function(BenchmarkId::new("1000x100", "end_of_step"), |b| {
+        let mut velocity = pile.velocity.clone();
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                velocity.copy_from_slice(&pile.velocity);
+                let start = Instant::now();
+                for range in &pile.chains {
+                    let chain = Chain {
+                        edges: &pile.edges[range.clone()],
+                        closed: false,
+                    };
+                    let bodies = Bodies {
+                        position: &pile.position,
+                        velocity: &mut velocity,
+                        inverse_mass: &pile.inverse_mass,
+                    };
+                    black_box(project_chain(
+                        chain,
+                        bodies,
+                        &[],
+                        dt,
+                        &settings,
+                        &mut scratch,
+                    ));
+                }
+                total += start.elapsed();
+            }
+            total
+        })
+    });
+    group.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30).measurement_time(Duration::from_secs(4));
+    targets = thomas, constraint_stage
+}
+criterion_main!(benches);

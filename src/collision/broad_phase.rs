@@ -1,0 +1,360 @@
+//! Broad phase: which point–edge (and edge–edge) pairs can touch this step.
+//!
+//! Every edge's swept box (its endpoints at the start and end of the step, inflated by
+//! the margin) is entered into a uniform grid, hashed into a table and stored by
+//! counting sort in reused buffers; each point's swept segment then queries the cells
+//! it covers. Cost grows near-linearly with the number of edges in a pile. Brute force
+//! (every pair) stays available for testing.
+
+use bevy::math::DVec2;
+use bevy::prelude::Reflect;
+
+use crate::topology::Edge;
+
+/// How candidate pairs are found.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BroadPhaseMethod {
+    /// Uniform hashed grid: near-linear.
+    #[default]
+    Grid,
+    /// Every pair: quadratic, for testing.
+    BruteForce,
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Lower corner.
+    pub min: DVec2,
+    /// Upper corner.
+    pub max: DVec2,
+}
+
+impl Aabb {
+    /// The box of a segment's sweep: both endpoints at the start and at the end.
+    pub fn swept(points: &[DVec2], margin: f64) -> Aabb {
+        let (mut min, mut max) = (points[0], points[0]);
+        for &p in &points[1..] {
+            min = min.min(p);
+            max = max.max(p);
+        }
+        Aabb {
+            min: min - DVec2::splat(margin),
+            max: max + DVec2::splat(margin),
+        }
+    }
+
+    /// Whether the boxes overlap (touching counts).
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.x <= other.max.x
+            && other.min.x <= self.max.x
+            && self.min.y <= other.max.y
+            && other.min.y <= self.max.y
+    }
+}
+
+/// More cells than this and an edge is checked against every query instead.
+const MAX_CELLS_PER_EDGE: i64 = 4096;
+
+/// Reusable broad-phase buffers.
+#[derive(Clone, Debug, Default)]
+pub struct BroadPhase {
+    edge_boxes: Vec<Aabb>,
+    cell_size: f64,
+    mask: usize,
+    bucket_start: Vec<u32>,
+    entries: Vec<u32>,
+    oversized: Vec<u32>,
+    cursor: Vec<u32>,
+    seen: Vec<u32>,
+}
+
+fn hash(ix: i64, iy: i64, mask: usize) -> usize {
+    ((ix.wrapping_mul(73_856_093) ^ iy.wrapping_mul(19_349_663)) as u64 as usize) & mask
+}
+
+impl BroadPhase {
+    fn cell_range(&self, b: &Aabb) -> (i64, i64, i64, i64) {
+        let f = |v: f64| (v / self.cell_size).floor() as i64;
+        (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y))
+    }
+
+    /// Whether a box is better tested against everything than entered in the grid.
+    fn is_oversized(&self, b: &Aabb) -> bool {
+        let (x0, y0, x1, y1) = self.cell_range(b);
+        !b.min.is_finite()
+            || !b.max.is_finite()
+            || x1
+                .saturating_sub(x0)
+                .saturating_add(1)
+                .saturating_mul(y1.saturating_sub(y0).saturating_add(1))
+                > MAX_CELLS_PER_EDGE
+    }
+
+    /// Build the grid over every edge's swept box: positions `x`, end positions
+    /// `x + d` (`None`: not moving), inflated by `margin`.
+    pub fn build(
+        &mut self,
+        edges: &[Edge],
+        position: &[DVec2],
+        displacement: Option<&[DVec2]>,
+        margin: f64,
+    ) {
+        self.edge_boxes.clear();
+        let mut extent = 0.0;
+        for e in edges {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let (da, db) = displacement.map_or((DVec2::ZERO, DVec2::ZERO), |d| (d[a], d[b]));
+            let b = Aabb::swept(
+                &[position[a], position[b], position[a] + da, position[b] + db],
+                margin,
+            );
+            let size = b.max - b.min;
+            if size.is_finite() {
+                extent += size.max_element();
+            }
+            self.edge_boxes.push(b);
+        }
+        let count = edges.len().max(1);
+        // A cell about the size of a typical edge's box.
+        self.cell_size = (extent / count as f64).max(1e-9);
+        let table = (2 * count).next_power_of_two();
+        self.mask = table - 1;
+        self.bucket_start.clear();
+        self.bucket_start.resize(table + 1, 0);
+        self.oversized.clear();
+
+        // Count, prefix-sum, fill: a counting sort of (bucket, edge) entries.
+        for k in 0..self.edge_boxes.len() {
+            let b = self.edge_boxes[k];
+            if self.is_oversized(&b) {
+                self.oversized.push(k as u32);
+                continue;
+            }
+            let (x0, y0, x1, y1) = self.cell_range(&b);
+            for ix in x0..=x1 {
+                for iy in y0..=y1 {
+                    self.bucket_start[hash(ix, iy, self.mask) + 1] += 1;
+                }
+            }
+        }
+        for i in 1..=table {
+            self.bucket_start[i] += self.bucket_start[i - 1];
+        }
+        self.entries.clear();
+        self.entries.resize(self.bucket_start[table] as usize, 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.bucket_start[..table]);
+        for k in 0..self.edge_boxes.len() {
+            let b = self.edge_boxes[k];
+            if self.is_oversized(&b) {
+                continue;
+            }
+            let (x0, y0, x1, y1) = self.cell_range(&b);
+            for ix in x0..=x1 {
+                for iy in y0..=y1 {
+                    let bucket = hash(ix, iy, self.mask);
+                    self.entries[self.cursor[bucket] as usize] = k as u32;
+                    self.cursor[bucket] += 1;
+                }
+            }
+        }
+    }
+
+    /// Visit each edge whose box overlaps `query` once (in a fixed order). `stamp`
+    /// must differ between consecutive queries and be non-zero.
+    fn visit(&mut self, query: &Aabb, stamp: u32, mut visit: impl FnMut(u32)) {
+        if self.is_oversized(query) {
+            // A huge query: test every edge.
+            for k in 0..self.edge_boxes.len() as u32 {
+                if self.edge_boxes[k as usize].overlaps(query) {
+                    visit(k);
+                }
+            }
+            return;
+        }
+        let (x0, y0, x1, y1) = self.cell_range(query);
+        for ix in x0..=x1 {
+            for iy in y0..=y1 {
+                let bucket = hash(ix, iy, self.mask);
+                for slot in self.bucket_start[bucket]..self.bucket_start[bucket + 1] {
+                    let k = self.entries[slot as usize];
+                    if self.seen[k as usize] != stamp {
+                        self.seen[k as usize] = stamp;
+                        if self.edge_boxes[k as usize].overlaps(query) {
+                            visit(k);
+                        }
+                    }
+                }
+            }
+        }
+        for i in 0..self.oversized.len() {
+            let k = self.oversized[i];
+            if self.edge_boxes[k as usize].overlaps(query) {
+                visit(k);
+            }
+        }
+    }
+
+    fn reset_seen(&mut self) {
+        self.seen.clear();
+        self.seen.resize(self.edge_boxes.len(), 0);
+    }
+
+    /// Append every (point, edge) pair whose swept boxes overlap and for which `keep`
+    /// holds, in point order. Call [`BroadPhase::build`] first.
+    pub fn point_edge_pairs(
+        &mut self,
+        method: BroadPhaseMethod,
+        position: &[DVec2],
+        displacement: &[DVec2],
+        keep: impl Fn(u32, u32) -> bool,
+        pairs: &mut Vec<(u32, u32)>,
+    ) {
+        self.reset_seen();
+        for i in 0..position.len() {
+            let query = Aabb::swept(&[position[i], position[i] + displacement[i]], 0.0);
+            let point = i as u32;
+            match method {
+                BroadPhaseMethod::Grid => self.visit(&query, point + 1, |k| {
+                    if keep(point, k) {
+                        pairs.push((point, k));
+                    }
+                }),
+                BroadPhaseMethod::BruteForce => {
+                    for k in 0..self.edge_boxes.len() as u32 {
+                        if self.edge_boxes[k as usize].overlaps(&query) && keep(point, k) {
+                            pairs.push((point, k));
+                        }
+                    }
+                }
+            }
+        }
+        if method == BroadPhaseMethod::Grid {
+            // Within a point, order by edge so the result is independent of the grid.
+            sort_runs(pairs);
+        }
+    }
+
+    /// Append every pair of edges (j < k) whose boxes overlap and for which `keep`
+    /// holds. Call [`BroadPhase::build`] first.
+    pub fn edge_edge_pairs(
+        &mut self,
+        method: BroadPhaseMethod,
+        keep: impl Fn(u32, u32) -> bool,
+        pairs: &mut Vec<(u32, u32)>,
+    ) {
+        self.reset_seen();
+        for j in 0..self.edge_boxes.len() as u32 {
+            let query = self.edge_boxes[j as usize];
+            match method {
+                BroadPhaseMethod::Grid => self.visit(&query, j + 1, |k| {
+                    if k > j && keep(j, k) {
+                        pairs.push((j, k));
+                    }
+                }),
+                BroadPhaseMethod::BruteForce => {
+                    for k in j + 1..self.edge_boxes.len() as u32 {
+                        if self.edge_boxes[k as usize].overlaps(&query) && keep(j, k) {
+                            pairs.push((j, k));
+                        }
+                    }
+                }
+            }
+        }
+        if method == BroadPhaseMethod::Grid {
+            sort_runs(pairs);
+        }
+    }
+}
+
+/// Sort pairs by (first, second); they arrive grouped by first already.
+fn sort_runs(pairs: &mut [(u32, u32)]) {
+    let mut start = 0;
+    while start < pairs.len() {
+        let first = pairs[start].0;
+        let end = start + pairs[start..].iter().take_while(|p| p.0 == first).count();
+        pairs[start..end].sort_unstable_by_key(|p| p.1);
+        start = end;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+
+    fn random_scene(rng: &mut StdRng, strands: usize) -> (Vec<DVec2>, Vec<DVec2>, Vec<Edge>) {
+        let (mut position, mut displacement, mut edges) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..strands {
+            let mut x = DVec2::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+            let first = position.len() as u32;
+            for i in 0..20 {
+                position.push(x);
+                displacement.push(DVec2::new(
+                    rng.random_range(-0.01..0.01),
+                    rng.random_range(-0.01..0.01),
+                ));
+                x += 0.01 * DVec2::from_angle(rng.random_range(0.0..6.3));
+                if i > 0 {
+                    edges.push(Edge {
+                        a: first + i - 1,
+                        b: first + i,
+                        rest_length: 0.01,
+                        strand: 0,
+                        is_static: false,
+                        constrained: false,
+                        spring: false,
+                        stiffness: 0.0,
+                        damping: 0.0,
+                    });
+                }
+            }
+        }
+        // A long static wall across everything.
+        position.push(DVec2::new(-0.5, 0.5));
+        position.push(DVec2::new(1.5, 0.5));
+        displacement.extend([DVec2::ZERO; 2]);
+        let n = position.len() as u32;
+        edges.push(Edge {
+            a: n - 2,
+            b: n - 1,
+            is_static: true,
+            ..edges[0]
+        });
+        (position, displacement, edges)
+    }
+
+    #[test]
+    fn grid_and_brute_force_find_the_same_pairs() {
+        let mut rng = StdRng::seed_from_u64(9);
+        for strands in [1, 10, 100] {
+            let (position, displacement, edges) = random_scene(&mut rng, strands);
+            let keep = |p: u32, k: u32| edges[k as usize].a != p && edges[k as usize].b != p;
+            let mut broad = BroadPhase::default();
+            broad.build(&edges, &position, Some(&displacement), 0.004);
+            let (mut grid, mut brute) = (Vec::new(), Vec::new());
+            broad.point_edge_pairs(
+                BroadPhaseMethod::Grid,
+                &position,
+                &displacement,
+                keep,
+                &mut grid,
+            );
+            broad.point_edge_pairs(
+                BroadPhaseMethod::BruteForce,
+                &position,
+                &displacement,
+                keep,
+                &mut brute,
+            );
+            assert_eq!(grid, brute, "{strands} strands");
+            assert!(!grid.is_empty());
+            let (mut grid, mut brute) = (Vec::new(), Vec::new());
+            broad.edge_edge_pairs(BroadPhaseMethod::Grid, |_, _| true, &mut grid);
+            broad.edge_edge_pairs(BroadPhaseMethod::BruteForce, |_, _| true, &mut brute);
+            assert_eq!(grid, brute, "{strands} strands");
+        }
+    }
+}
