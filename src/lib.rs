@@ -49,6 +49,7 @@ use collision::CollisionPlugin;
 use config::StrandsConfig;
 use constraints::ConstraintsPlugin;
 use metrics::StrandMetrics;
+use scenes::ScenesPlugin;
 use schedule::{SchedulePlugin, SimulationClock};
 use state::ParticleState;
 use topology::{InputProblems, Topology};
@@ -106,6 +107,7 @@ impl PluginGroup for StrandsPlugin {
             })
             .add(ConstraintsPlugin)
             .add(CollisionPlugin)
+            .add(ScenesPlugin)
     }
 }
 

@@ -8,6 +8,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::constraints::projection::ProjectionOutcome;
 use crate::state::ParticleState;
 use crate::topology::{Edge, Topology};
 
@@ -22,15 +23,18 @@ pub struct IterationStats {
     pub max: u32,
     /// Solves that stopped at the iteration cap without meeting the tolerance.
     pub capped: u64,
+    /// Solves whose corrections were too large to apply and were dropped.
+    pub rejected: u64,
 }
 
 impl IterationStats {
     /// Record one island solve.
-    pub fn record(&mut self, iterations: u32, converged: bool) {
+    pub fn record(&mut self, outcome: &ProjectionOutcome) {
         self.solves += 1;
-        self.iterations += iterations as u64;
-        self.max = self.max.max(iterations);
-        self.capped += u64::from(!converged);
+        self.iterations += outcome.iterations as u64;
+        self.max = self.max.max(outcome.iterations);
+        self.rejected += u64::from(outcome.rejected);
+        self.capped += u64::from(!outcome.converged && !outcome.rejected);
     }
 
     /// Mean iterations per solve (0 before any solve).
@@ -74,6 +78,9 @@ pub struct StrandMetrics {
     pub collisions_last_step: u64,
     /// Steps that needed the collision fail-safe.
     pub failsafe_steps: u64,
+    /// Steps whose collisions still needed impulses after the last re-projection, so
+    /// that edges next to those contacts end the step as the impulses left them.
+    pub contact_unsettled_steps: u64,
     /// Collisions the fail-safe could not resolve (only kinematic particles driven
     /// into each other can cause these).
     pub unresolved_collisions: u64,

@@ -46,6 +46,11 @@ pub struct Report {
     pub contact_projection_iterations_max: u32,
     /// Re-projections in contact that stopped at the cap.
     pub contact_projection_capped_solves: u64,
+    /// Re-projections in contact dropped because they asked for absurd corrections.
+    pub contact_projection_rejected_solves: u64,
+    /// Steps whose collisions still needed impulses after the last re-projection:
+    /// edges next to those contacts end the step as the impulses left them.
+    pub contact_unsettled_steps: u64,
     /// Wall-clock seconds of the run's ticks.
     pub wall_seconds: f64,
     /// Particles × steps per wall-clock second.
@@ -98,11 +103,13 @@ impl Report {
             (
                 "contact_projection",
                 format!(
-                    "{} solves, mean {:.2}, max {}, capped {}",
+                    "{} solves, mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
                     self.contact_projection_solves,
                     self.contact_projection_iterations_mean,
                     self.contact_projection_iterations_max,
-                    self.contact_projection_capped_solves
+                    self.contact_projection_capped_solves,
+                    self.contact_projection_rejected_solves,
+                    self.contact_unsettled_steps
                 ),
             ),
             ("wall_seconds", format!("{:.3}", self.wall_seconds)),

@@ -168,6 +168,8 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         contact_projection_iterations_mean: metrics.contact_projection.mean(),
         contact_projection_iterations_max: metrics.contact_projection.max,
         contact_projection_capped_solves: metrics.contact_projection.capped,
+        contact_projection_rejected_solves: metrics.contact_projection.rejected,
+        contact_unsettled_steps: metrics.contact_unsettled_steps,
         wall_seconds,
         particle_steps_per_second: if wall_seconds > 0.0 {
             particle_steps as f64 / wall_seconds

@@ -25,6 +25,7 @@ pub mod failsafe;
 pub mod response;
 
 use bevy::math::DVec2;
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
 use crate::config::StrandsConfig;
@@ -95,6 +96,7 @@ pub struct CollisionScratch {
     pairs: Vec<(u32, u32)>,
     displacement: Vec<DVec2>,
     contacts: Vec<Contact>,
+    contact_index: HashMap<(u32, u32), u32>,
     contact_rows: Vec<ContactRow>,
     reprojection_inverse_mass: Vec<f64>,
     zones: ImpactZones,
@@ -219,15 +221,16 @@ impl Contacts<'_> {
             normal,
         };
         // One record per point and edge: the latest contact between them.
-        match self
-            .scratch
-            .contacts
-            .iter_mut()
-            .rev()
-            .find(|c| c.p == contact.p && c.edge == edge)
-        {
-            Some(existing) => *existing = contact,
-            None => self.scratch.contacts.push(contact),
+        let scratch = &mut *self.scratch;
+        let next = scratch.contacts.len() as u32;
+        let slot = *scratch
+            .contact_index
+            .entry((contact.p, edge))
+            .or_insert(next);
+        if slot == next {
+            scratch.contacts.push(contact);
+        } else {
+            scratch.contacts[slot as usize] = contact;
         }
         true
     }
@@ -349,18 +352,39 @@ impl Contacts<'_> {
         settings: &ProjectionSettings,
         metrics: &mut StrandMetrics,
     ) {
+        // Rows: every contact met this step, and every pair already closer than twice
+        // the thickness. Each may approach while it ends the step at least half the
+        // thickness apart (the next proximity pass restores the rest); asking for no
+        // approach at all over-constrains a jammed pile.
+        let keep = 0.5 * self.config.thickness;
+        let (position, velocity, dt) = (self.position, &*self.velocity, self.dt);
+        let row = |p: u32, e: &Edge, alpha: f64, normal: DVec2| {
+            let mut row = ContactRow::point_edge(p, e.a, e.b, alpha, normal, velocity);
+            let contact_point = position[e.a as usize].lerp(position[e.b as usize], alpha);
+            let gap = normal.dot(position[p as usize] - contact_point);
+            row.target = row.target.min((keep - gap) / dt);
+            row
+        };
         let scratch = &mut *self.scratch;
         scratch.contact_rows.clear();
         for c in &scratch.contacts {
             let e = &self.edges[c.edge as usize];
-            scratch.contact_rows.push(ContactRow::point_edge(
-                c.p,
-                e.a,
-                e.b,
-                c.alpha,
-                c.normal,
-                self.velocity,
-            ));
+            scratch.contact_rows.push(row(c.p, e, c.alpha, c.normal));
+        }
+        for &(p, k) in &scratch.pairs {
+            let e = &self.edges[k as usize];
+            if scratch.contact_index.contains_key(&(p, k)) {
+                continue;
+            }
+            let x = position[p as usize];
+            let (alpha, distance) =
+                closest_on_segment(x, position[e.a as usize], position[e.b as usize]);
+            if distance > 0.0 && distance < 2.0 * self.config.thickness {
+                let contact_point = position[e.a as usize].lerp(position[e.b as usize], alpha);
+                scratch
+                    .contact_rows
+                    .push(row(p, e, alpha, (x - contact_point) / distance));
+            }
         }
         scratch.reprojection_inverse_mass.clear();
         scratch
@@ -453,6 +477,7 @@ pub fn collide(
     }
     let scratch = &mut *scratch;
     scratch.contacts.clear();
+    scratch.contact_index.clear();
     scratch.zones.reset(position.len());
     let mut contacts = Contacts {
         edges: &topology.edges,
@@ -480,9 +505,9 @@ pub fn collide(
         // last, so non-penetration is never traded for length.
         let settings = ProjectionSettings {
             max_correction: 0.5,
-            // Contacts met to a millionth of the thickness per step: far inside the
-            // cushion, while the edges are met exactly.
-            contact_tolerance: 1e-6 * config.thickness,
+            // Contacts met to a thousandth of the thickness per step, well inside the
+            // cushion (the edges are met exactly whatever the contacts do).
+            contact_tolerance: 1e-3 * config.thickness,
             ..constraint.projection()
         };
         let mut changed = total.impulses > 0;
@@ -497,6 +522,7 @@ pub fn collide(
             total.failsafe |= crossings.failsafe;
             total.unresolved += crossings.unresolved;
         }
+        metrics.contact_unsettled_steps += u64::from(changed);
     }
     metrics.collisions += total.impulses;
     metrics.collisions_last_step = total.impulses;

@@ -288,7 +288,7 @@ impl Islands {
             settings,
             &mut scratch,
         );
-        stats.record(outcome.iterations, outcome.converged);
+        stats.record(&outcome);
         self.scratch = scratch;
     }
 }

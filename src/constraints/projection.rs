@@ -74,7 +74,8 @@ pub struct ProjectionSettings {
 pub struct ProjectionOutcome {
     /// Linear solves performed.
     pub iterations: u32,
-    /// Whether the edge tolerance was met (and the contacts' too, with contacts).
+    /// Whether the edge tolerance was met. Contacts are met to their tolerance or as
+    /// well as the complementarity solve could: see `contact_violation`.
     pub converged: bool,
     /// Final `max |C_k| / L_k²`.
     pub residual: f64,
@@ -133,6 +134,11 @@ impl ContactRow {
             .sum()
     }
 }
+
+/// Edge residual (`|C| / L²`) below which the contacts may be settled and the edges
+/// polished alone: the remaining corrections are then a millionth of an edge, too small
+/// to disturb a contact.
+const POLISH_RESIDUAL: f64 = 1e-6;
 
 /// Contact rows one projection takes at most; further ones are left to the collision
 /// stage's verification.
@@ -337,6 +343,7 @@ pub fn project_chain(
         ..Default::default()
     };
     let contact_tolerance = settings.contact_tolerance;
+    let mut previous_violation = f64::INFINITY;
     loop {
         let s = &mut *scratch;
         let mut residual = 0.0f64;
@@ -351,8 +358,18 @@ pub fn project_chain(
         let violation = contact_violation(&s.rows, &s.correction);
         outcome.residual = residual;
         outcome.contact_violation = violation;
+        // The contacts are met to their tolerance, or as well as the complementarity
+        // solve manages once that stops improving; then they are settled, and the last
+        // iterations polish the edges alone, converging quadratically (an inexact
+        // contact solve would otherwise leave its noise, squared, in the edges).
+        let nearly = residual <= POLISH_RESIDUAL;
+        let settled = violation <= contact_tolerance || violation > 0.5 * previous_violation;
+        if !s.rows.is_empty() && nearly && settled {
+            s.rows.clear();
+        }
+        previous_violation = violation;
         let edges_done = residual <= settings.tolerance.max(ROUND_OFF_FLOOR);
-        if edges_done && violation <= contact_tolerance {
+        if edges_done && s.rows.is_empty() {
             outcome.converged = true;
             break;
         }
@@ -423,6 +440,16 @@ fn localize_contacts(
             scratch.rows.push(local);
         }
     }
+    // Which rows meet at which particle, for the N W Nᵀ terms.
+    scratch.row_particles.clear();
+    for (c, row) in scratch.rows.iter().enumerate() {
+        for &(j, coefficient) in &row.entries[..row.count] {
+            scratch.row_particles.push((j, c as u32, coefficient));
+        }
+    }
+    scratch
+        .row_particles
+        .sort_unstable_by_key(|&(j, c, _)| (j, c));
     for j in 0..particles {
         scratch.local_of[particle(j)] = NOT_IN_CHAIN;
     }
@@ -551,13 +578,6 @@ fn newton_step(
             }
         }
         // N W Nᵀ: only rows that share a particle meet.
-        s.row_particles.clear();
-        for (c, row) in s.rows.iter().enumerate() {
-            for &(j, coefficient) in &row.entries[..row.count] {
-                s.row_particles.push((j, c as u32, coefficient));
-            }
-        }
-        s.row_particles.sort_unstable_by_key(|&(j, c, _)| (j, c));
         let mut start = 0;
         while start < s.row_particles.len() {
             let j = s.row_particles[start].0;
@@ -899,10 +919,12 @@ mod tests {
             let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
             assert!(outcome.converged, "{outcome:?}");
             assert!(case.max_relative_error(&v) < 1e-12);
-            assert!(contact.normal_velocity(&v) >= contact.target - 1e-9);
+            // Met up to the final edge polish: a millionth of an edge per step.
+            let polish = POLISH_RESIDUAL * 0.1 / case.dt;
+            assert!(contact.normal_velocity(&v) >= contact.target - polish);
             if kick < 0.0 {
                 // Pulled down into the floor: the contact holds it.
-                assert!(v[0].y.abs() < 1e-9, "{}", v[0].y);
+                assert!(v[0].y.abs() <= polish, "{}", v[0].y);
             } else {
                 // Pulled up, away from the floor: the contact lets go.
                 assert!(v[0].y > 1e-6, "{}", v[0].y);
@@ -958,7 +980,8 @@ mod tests {
             let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
             assert!(outcome.converged, "{outcome:?}");
             assert!(case.max_relative_error(&v) < 1e-12);
-            assert!(contact.normal_velocity(&v) >= contact.target - 1e-9);
+            let polish = POLISH_RESIDUAL * 0.02 / case.dt;
+            assert!(contact.normal_velocity(&v) >= contact.target - polish);
         }
     }
 }

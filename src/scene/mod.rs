@@ -7,7 +7,7 @@
 
 mod spawn;
 
-pub use spawn::spawn_scene;
+pub use spawn::{container_builder, spawn_scene};
 
 use std::path::Path;
 
@@ -69,6 +69,36 @@ pub struct Scene {
     /// Loose particles.
     #[serde(default)]
     pub particles: Vec<ParticleSpec>,
+    /// A spaghetti factory.
+    #[serde(default)]
+    pub spaghetti_factory: Option<SpaghettiFactorySpec>,
+}
+
+/// The spaghetti factory (see [`SpaghettiFactory`](crate::scenes::spaghetti_factory::SpaghettiFactory)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpaghettiFactorySpec {
+    /// Where particles appear.
+    pub inlet: [f64; 2],
+    /// Their velocity there.
+    pub velocity: [f64; 2],
+    /// Seconds between particles.
+    pub interval: f64,
+    /// Particles per strand.
+    pub particles_per_strand: usize,
+    /// Newest particles held at the inlet velocity.
+    #[serde(default = "two")]
+    pub held: usize,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Stop after this many strands.
+    #[serde(default)]
+    pub max_strands: Option<usize>,
+}
+
+fn two() -> usize {
+    2
 }
 
 fn default_gravity() -> [f64; 2] {
@@ -367,6 +397,28 @@ impl Scene {
             strand
                 .validate()
                 .map_err(|(field, p)| fail(&format!("{item}{field}"), p))?;
+        }
+        if let Some(f) = &self.spaghetti_factory {
+            let at = |field: &str| format!("spaghetti_factory.{field}");
+            finite2(f.inlet).map_err(|p| fail(&at("inlet"), p))?;
+            finite2(f.velocity).map_err(|p| fail(&at("velocity"), p))?;
+            positive("interval", f.interval).map_err(|p| fail(&at("interval"), p))?;
+            positive("mass", f.mass).map_err(|p| fail(&at("mass"), p))?;
+            if f.velocity[0] == 0.0 && f.velocity[1] == 0.0 {
+                return Err(fail(
+                    &at("velocity"),
+                    "must not be zero: it sets the strands' rest spacing".into(),
+                ));
+            }
+            if f.particles_per_strand < 2 {
+                return Err(fail(
+                    &at("particles_per_strand"),
+                    format!(
+                        "a strand needs at least 2 particles, got {}",
+                        f.particles_per_strand
+                    ),
+                ));
+            }
         }
         for (i, particle) in self.particles.iter().enumerate() {
             let item = format!("particles[{i}]");

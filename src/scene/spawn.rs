@@ -8,6 +8,7 @@ use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
 use crate::constraints::ConstraintConfig;
 use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
+use crate::scenes::spaghetti_factory::SpaghettiFactory;
 use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
 
 /// Configure the world's resources from the scene and spawn its walls, strands and
@@ -47,6 +48,18 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
             .builder()
             .spawn_in(world)
             .map_err(|e| fail(format!("strands[{i}]"), e.to_string()))?;
+    }
+    if let Some(f) = &scene.spaghetti_factory {
+        let mut factory = SpaghettiFactory::new(
+            vec2(f.inlet),
+            vec2(f.velocity),
+            f.interval,
+            f.particles_per_strand,
+        );
+        factory.held = f.held;
+        factory.mass = f.mass;
+        factory.max_strands = f.max_strands;
+        world.spawn(factory);
     }
     for particle in &scene.particles {
         let mut entity = world.spawn((

@@ -1,7 +1,26 @@
 //! The canonical scenarios of ../shared/SCENARIOS.md, built into the crate so the
-//! runner works from anywhere. Their text is the scene file under `assets/scenes/`.
+//! runner works from anywhere (their text is the scene file under `assets/scenes/`),
+//! and the scenario logic that runs during a simulation (factories).
+
+pub mod spaghetti_factory;
+
+use bevy::prelude::*;
 
 use crate::scene::{Scene, SceneError};
+use crate::schedule::{StrandsTick, TickSet};
+use spaghetti_factory::{SpaghettiFactory, run_spaghetti_factories};
+
+/// Scenario logic: factories and other scripted sources.
+pub struct ScenesPlugin;
+
+impl Plugin for ScenesPlugin {
+    fn build(&self, app: &mut App) {
+        app.register_type::<SpaghettiFactory>().add_systems(
+            StrandsTick,
+            run_spaghetti_factories.in_set(TickSet::Prepare),
+        );
+    }
+}
 
 /// A scenario shipped with the crate.
 #[derive(Clone, Copy, Debug)]
@@ -22,11 +41,18 @@ impl BuiltinScene {
 }
 
 /// Every built-in scenario.
-pub const BUILTIN_SCENES: &[BuiltinScene] = &[BuiltinScene {
-    name: "long_strand",
-    file: "assets/scenes/long_strand.ron",
-    text: include_str!("../../assets/scenes/long_strand.ron"),
-}];
+pub const BUILTIN_SCENES: &[BuiltinScene] = &[
+    BuiltinScene {
+        name: "long_strand",
+        file: "assets/scenes/long_strand.ron",
+        text: include_str!("../../assets/scenes/long_strand.ron"),
+    },
+    BuiltinScene {
+        name: "spaghetti_factory",
+        file: "assets/scenes/spaghetti_factory.ron",
+        text: include_str!("../../assets/scenes/spaghetti_factory.ron"),
+    },
+];
 
 /// The built-in scenario called `name`.
 pub fn builtin(name: &str) -> Option<&'static BuiltinScene> {
