@@ -34,6 +34,12 @@ pub struct RunOptions {
     pub substeps: Option<u32>,
     /// Constraint solver, instead of the scene's.
     pub solver: Option<String>,
+    /// Projection iteration cap, instead of the scene's.
+    pub iterations: Option<u32>,
+    /// Keep stretch springs on constrained edges.
+    pub stretch_springs: bool,
+    /// Take the constraint direction at the start of the step.
+    pub start_of_step: bool,
     /// Whether to count edge crossings at every step end.
     pub check_crossings: bool,
 }
@@ -77,6 +83,11 @@ pub fn load_scene(options: &RunOptions) -> Result<Scene, RunError> {
     if let Some(solver) = &options.solver {
         scene.solver = solver.clone();
     }
+    if let Some(iterations) = options.iterations {
+        scene.constraints.max_iterations = iterations;
+    }
+    scene.constraints.stretch_springs |= options.stretch_springs;
+    scene.constraints.start_of_step |= options.start_of_step;
     scene.validate("command line")?;
     Ok(scene)
 }

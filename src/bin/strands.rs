@@ -1,5 +1,6 @@
 //! `strands`: run a canonical scenario headless and print its report.
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,6 +47,17 @@ struct RunArgs {
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
+    /// Cap on constraint-projection iterations per island per step (default: the
+    /// scene's, 20).
+    #[arg(long, value_name = "N")]
+    iterations: Option<u32>,
+    /// Keep stretch springs on constrained edges too (constraint-drift studies).
+    #[arg(long)]
+    stretch_springs: bool,
+    /// Take the constraint direction at the start of the step (torque-free impulses)
+    /// instead of at the end (fast projection).
+    #[arg(long)]
+    start_of_step: bool,
     /// Print the report as one JSON object alone on stdout.
     #[arg(long)]
     json: bool,
@@ -62,14 +74,20 @@ fn solver_help() -> String {
     help
 }
 
+/// Write to stdout; a closed pipe (`strands … | head`) ends the output quietly.
+fn emit(text: &str) {
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::List => {
             for scene in BUILTIN_SCENES {
                 match scene.scene() {
-                    Ok(s) => println!("{:<20} {}", scene.name, s.description),
-                    Err(e) => println!("{:<20} (invalid: {e})", scene.name),
+                    Ok(s) => emit(&format!("{:<20} {}\n", scene.name, s.description)),
+                    Err(e) => emit(&format!("{:<20} (invalid: {e})\n", scene.name)),
                 }
             }
             ExitCode::SUCCESS
@@ -82,15 +100,18 @@ fn main() -> ExitCode {
                 dt: args.dt,
                 substeps: args.substeps,
                 solver: args.solver,
+                iterations: args.iterations,
+                stretch_springs: args.stretch_springs,
+                start_of_step: args.start_of_step,
                 check_crossings: !args.no_check,
             };
             match run(&options, |_| {}) {
                 Ok(report) if args.json => {
-                    println!("{}", report.to_json());
+                    emit(&format!("{}\n", report.to_json()));
                     ExitCode::SUCCESS
                 }
                 Ok(report) => {
-                    print!("{}", report.to_table());
+                    emit(&report.to_table());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

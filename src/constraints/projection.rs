@@ -39,7 +39,7 @@ use bevy::prelude::Reflect;
 
 use super::cyclic::CyclicFactor;
 use super::islands::IslandEdge;
-use super::tridiagonal::{SingularPivot, TridiagonalFactor};
+use super::tridiagonal::{SingularPivot, TridiagonalFactor, solve_tridiagonal};
 
 /// Where the constraint direction is evaluated (DESIGN §5).
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -168,6 +168,7 @@ pub struct ChainScratch {
     diagonal: Vec<f64>,
     upper: Vec<f64>,
     rhs: Vec<f64>,
+    thomas: Vec<f64>,
     open_factor: TridiagonalFactor,
     cyclic_factor: CyclicFactor,
     local_of: Vec<u32>,
@@ -197,6 +198,7 @@ impl ChainScratch {
             &mut self.diagonal,
             &mut self.upper,
             &mut self.rhs,
+            &mut self.thomas,
         ] {
             grow(buffer, edges, 0.0);
         }
@@ -511,15 +513,27 @@ fn newton_step(
         s.lower[0] = 0.0;
         s.upper[m - 1] = 0.0;
     }
-    // Factor once; solve the edge system and every contact column with it.
+    let rows = s.rows.len();
     let cyclic = closed && m >= 3;
-    if cyclic {
+    if rows == 0 && !cyclic {
+        // One right-hand side: the fused single-pass Thomas solve is fastest.
+        solve_tridiagonal(
+            &s.lower[..m],
+            &s.diagonal[..m],
+            &s.upper[..m],
+            &mut s.rhs[..m],
+            &mut s.thomas[..m],
+        )?;
+    } else if cyclic {
         s.cyclic_factor
             .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
+        s.cyclic_factor.solve(&mut s.rhs[..m]);
     } else {
         s.open_factor
             .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
+        s.open_factor.solve(&mut s.rhs[..m]);
     }
+    // Further right-hand sides reuse the factorization.
     let (open_factor, cyclic_factor) = (&s.open_factor, &s.cyclic_factor);
     let solve = |columns: &mut [f64], k: usize| {
         if cyclic {
@@ -528,9 +542,7 @@ fn newton_step(
             open_factor.solve_many(columns, k);
         }
     };
-    solve(&mut s.rhs[..m], 1);
 
-    let rows = s.rows.len();
     if rows > 0 {
         // Columns b_c = J W N_cᵀ, then Y = A⁻¹ B, all columns at once (row-major).
         let solved = &mut s.solved_columns[..m * rows];

@@ -57,6 +57,9 @@ pub struct Scene {
     /// Default material of the strands.
     #[serde(default)]
     pub material: MaterialSpec,
+    /// Constraint solver settings.
+    #[serde(default)]
+    pub constraints: ConstraintSpec,
     /// Collision settings.
     #[serde(default)]
     pub collisions: CollisionSpec,
@@ -151,6 +154,33 @@ impl From<MaterialSpec> for StrandMaterial {
             stretch_damping: m.stretch_damping,
             bending_stiffness: m.bending_stiffness,
             bending_damping: m.bending_damping,
+        }
+    }
+}
+
+/// Constraint solver parameters (see [`ConstraintConfig`](crate::constraints::ConstraintConfig)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct ConstraintSpec {
+    /// Stop projecting when every `|C| / L²` is at most this.
+    pub tolerance: f64,
+    /// Linear solves per island per step at most.
+    pub max_iterations: u32,
+    /// Take the constraint direction at the start of the step instead of the end.
+    pub start_of_step: bool,
+    /// Keep stretch springs on constrained edges too.
+    pub stretch_springs: bool,
+}
+
+impl Default for ConstraintSpec {
+    fn default() -> Self {
+        let c = crate::constraints::ConstraintConfig::default();
+        Self {
+            tolerance: c.tolerance,
+            max_iterations: c.max_iterations,
+            start_of_step: c.direction
+                == crate::constraints::projection::ConstraintDirection::StartOfStep,
+            stretch_springs: c.stretch_springs,
         }
     }
 }

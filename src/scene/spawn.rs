@@ -7,6 +7,7 @@ use super::{Scene, SceneError, vec2};
 use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
 use crate::constraints::ConstraintConfig;
+use crate::constraints::projection::ConstraintDirection;
 use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
 use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
@@ -28,7 +29,18 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
         config.damping = scene.damping;
         config.material = scene.material.into();
     }
-    world.get_resource_or_init::<ConstraintConfig>().solver = solver;
+    {
+        let mut constraints = world.get_resource_or_init::<ConstraintConfig>();
+        constraints.solver = solver;
+        constraints.tolerance = scene.constraints.tolerance;
+        constraints.max_iterations = scene.constraints.max_iterations;
+        constraints.direction = if scene.constraints.start_of_step {
+            ConstraintDirection::StartOfStep
+        } else {
+            ConstraintDirection::EndOfStep
+        };
+        constraints.stretch_springs = scene.constraints.stretch_springs;
+    }
     {
         let mut collisions = world.get_resource_or_init::<CollisionConfig>();
         collisions.enabled = scene.collisions.enabled;

@@ -1,0 +1,108 @@
+//! Criterion benchmark of one Collide stage on settling piles of 1k, 10k and 100k
+//! particles, uniform-grid broad phase against brute force.
+//!
+//! The pile: strands of 100 particles lying in rows 0.9 thicknesses apart, sinking at
+//! a few centimetres per second with some jitter, so that every particle is in
+//! proximity contact with the row below and the contact re-projection has every
+//! island to solve. Each iteration restores the same velocities and
+//! runs the whole stage (proximity, detection, impulses, contact re-projection).
+//! Run with `cargo bench --bench collisions`; results per machine are in
+//! `benches/RESULTS.md`.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_strands::collision::broad_phase::BroadPhaseMethod;
+use bevy_strands::collision::collide;
+use bevy_strands::prelude::*;
+use bevy_strands::scene::container_builder;
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+
+const PER_STRAND: usize = 100;
+
+fn pile(particles: usize, method: BroadPhaseMethod) -> (App, Vec<DVec2>) {
+    let mut app = App::new();
+    app.add_plugins(StrandsPlugin::manual());
+    app.finish();
+    app.cleanup();
+    let world = app.world_mut();
+    world.resource_mut::<StrandsConfig>().substeps = 1;
+    let strands = particles / PER_STRAND;
+    let gap = 0.9 * 0.004;
+    container_builder(DVec2::ZERO, DVec2::new(1.02, gap * (strands + 2) as f64))
+        .spawn_in(world)
+        .unwrap();
+    for s in 0..strands {
+        let points = (0..PER_STRAND).map(|i| {
+            let wave = 0.001 * ((i + s) as f64 * 0.7).sin();
+            DVec2::new(0.01 + 0.01 * i as f64, gap * (s + 1) as f64 + wave)
+        });
+        StrandBuilder::polyline(points).spawn_in(world).unwrap();
+    }
+    // Build topology and islands without moving anything.
+    world.resource_mut::<CollisionConfig>().enabled = false;
+    world.resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
+    world.run_schedule(StrandsTick);
+    let mut config = world.resource_mut::<CollisionConfig>();
+    config.enabled = true;
+    config.broad_phase = method;
+    let state = world.resource::<ParticleState>();
+    let velocity = (0..state.len())
+        .map(|i| {
+            if state.is_pinned(i) {
+                DVec2::ZERO
+            } else {
+                let jitter = ((i * 7919) % 101) as f64 / 101.0 - 0.5;
+                DVec2::new(0.02 * jitter, -0.05 - 0.03 * jitter)
+            }
+        })
+        .collect();
+    (app, velocity)
+}
+
+fn collide_stage(c: &mut Criterion) {
+    let mut group = c.benchmark_group("collide_stage");
+    group.sample_size(10).warm_up_time(Duration::from_secs(1));
+    for particles in [1_000usize, 10_000, 100_000] {
+        for method in [BroadPhaseMethod::Grid, BroadPhaseMethod::BruteForce] {
+            if method == BroadPhaseMethod::BruteForce && particles > 10_000 {
+                // 10¹⁰ box tests per detection pass: minutes per sample.
+                continue;
+            }
+            let (mut app, velocity) = pile(particles, method);
+            let world = app.world_mut();
+            world
+                .resource_mut::<ParticleState>()
+                .velocity
+                .copy_from_slice(&velocity);
+            world.run_system_cached(collide).unwrap();
+            let impulses = world.resource::<StrandMetrics>().collisions_last_step;
+            eprintln!("{particles} particles, {method:?}: {impulses} impulses per stage");
+            group.throughput(Throughput::Elements(particles as u64));
+            let name = format!("{method:?}").to_lowercase();
+            group.bench_function(BenchmarkId::new(name, particles), |b| {
+                b.iter_custom(|iters| {
+                    let mut total = Duration::ZERO;
+                    for _ in 0..iters {
+                        let world = app.world_mut();
+                        world
+                            .resource_mut::<ParticleState>()
+                            .velocity
+                            .copy_from_slice(&velocity);
+                        let start = Instant::now();
+                        world.run_system_cached(collide).unwrap();
+                        black_box(&world.resource::<ParticleState>().velocity);
+                        total += start.elapsed();
+                    }
+                    total
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, collide_stage);
+criterion_main!(benches);
