@@ -28,6 +28,7 @@
 pub mod collision;
 pub mod config;
 pub mod constraints;
+pub mod export;
 pub mod forces;
 pub mod integrate;
 pub mod metrics;

@@ -60,6 +60,10 @@ pub struct StrandMetrics {
     pub max_rel_length_error_free_now: f64,
     /// As `max_rel_length_error`, over edges away from contacts.
     pub max_rel_length_error_free: f64,
+    /// Largest relative length error over the steps of the latest tick.
+    pub tick_max_rel_length_error: f64,
+    /// As `tick_max_rel_length_error`, over edges away from contacts.
+    pub tick_max_rel_length_error_free: f64,
     /// Simulated particles.
     pub particles: usize,
     /// Simulated strands.
@@ -161,6 +165,42 @@ pub fn measure(
     metrics.max_rel_length_error_free_now = free;
     metrics.max_rel_length_error = metrics.max_rel_length_error.max(all);
     metrics.max_rel_length_error_free = metrics.max_rel_length_error_free.max(free);
+    metrics.tick_max_rel_length_error = metrics.tick_max_rel_length_error.max(all);
+    metrics.tick_max_rel_length_error_free = metrics.tick_max_rel_length_error_free.max(free);
+}
+
+/// One tick's length errors, for plots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorSample {
+    /// Simulated time at the end of the tick.
+    pub time: f64,
+    /// Largest relative length error over the tick's steps.
+    pub all: f64,
+    /// The same over edges away from contacts.
+    pub free: f64,
+}
+
+/// The length error of every tick, recorded while this resource exists (insert it to
+/// plot; it grows by one sample per tick).
+#[derive(Resource, Default, Debug, Clone)]
+pub struct LengthErrorHistory {
+    /// One sample per tick, oldest first.
+    pub samples: Vec<ErrorSample>,
+}
+
+/// Append the tick's sample to the history, if one is kept.
+pub fn record_length_error_history(
+    metrics: Res<StrandMetrics>,
+    clock: Res<crate::schedule::SimulationClock>,
+    history: Option<ResMut<LengthErrorHistory>>,
+) {
+    if let Some(mut history) = history {
+        history.samples.push(ErrorSample {
+            time: clock.time,
+            all: metrics.tick_max_rel_length_error,
+            free: metrics.tick_max_rel_length_error_free,
+        });
+    }
 }
 
 /// Refresh the counts after a topology rebuild.

@@ -59,6 +59,8 @@ pub struct Report {
     pub notes: Vec<String>,
     /// Problems found in the input, and what was done about them.
     pub input_problems: Vec<String>,
+    /// Pictures written (GIF, PNG frames, plot).
+    pub pictures: Vec<String>,
 }
 
 impl Report {
@@ -128,6 +130,9 @@ impl Report {
         }
         for problem in &self.input_problems {
             out.push_str(&format!("input problem: {problem}\n"));
+        }
+        for picture in &self.pictures {
+            out.push_str(&format!("wrote {picture}\n"));
         }
         out
     }

@@ -11,6 +11,9 @@ use crate::StrandsPlugin;
 use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
 use crate::constraints::{ConstraintConfig, SolverKind};
+use crate::export::plot::plot_length_error;
+use crate::export::{ExportError, FrameSettings, Recorder};
+use crate::metrics::LengthErrorHistory;
 use crate::metrics::StrandMetrics;
 use crate::report::Report;
 use crate::scene::{Scene, SceneError, spawn_scene};
@@ -42,11 +45,28 @@ pub struct RunOptions {
     pub start_of_step: bool,
     /// Whether to count edge crossings at every step end.
     pub check_crossings: bool,
+    /// Turn collisions off.
+    pub no_collisions: bool,
+    /// Strands of the scale scenario, instead of the scene's.
+    pub strands: Option<usize>,
+    /// Particles per strand of the scale scenario, instead of the scene's.
+    pub particles: Option<usize>,
+    /// Write an animated GIF here.
+    pub gif: Option<PathBuf>,
+    /// Write numbered PNG frames into this directory.
+    pub frames: Option<PathBuf>,
+    /// Write the length-error plot (PNG) here.
+    pub plot: Option<PathBuf>,
+    /// Frame size and rate of `gif` and `frames`.
+    pub frame_settings: FrameSettings,
 }
 
-/// Why a run could not start.
+/// Why a run could not start or finish.
 #[derive(Debug, Error)]
 pub enum RunError {
+    /// Pictures could not be written.
+    #[error(transparent)]
+    Export(#[from] ExportError),
     /// The scene is invalid.
     #[error(transparent)]
     Scene(#[from] SceneError),
@@ -88,6 +108,23 @@ pub fn load_scene(options: &RunOptions) -> Result<Scene, RunError> {
     }
     scene.constraints.stretch_springs |= options.stretch_springs;
     scene.constraints.start_of_step |= options.start_of_step;
+    if options.no_collisions {
+        scene.collisions.enabled = false;
+    }
+    if options.strands.is_some() || options.particles.is_some() {
+        let Some(scale) = &mut scene.scale else {
+            return Err(RunError::Scene(SceneError {
+                file: "command line".into(),
+                item: "--strands/--particles".into(),
+                problem: format!(
+                    "only the scale scenario has them; {} has no scale section",
+                    scene.name
+                ),
+            }));
+        };
+        scale.strands = options.strands.unwrap_or(scale.strands);
+        scale.particles = options.particles.unwrap_or(scale.particles);
+    }
     scene.validate("command line")?;
     Ok(scene)
 }
@@ -112,10 +149,25 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
     if options.check_crossings {
         world.resource_mut::<StrandMetrics>().edge_crossings = Some(0);
     }
+    if options.plot.is_some() {
+        world.init_resource::<LengthErrorHistory>();
+    }
+    let mut recorder = if options.gif.is_some() || options.frames.is_some() {
+        Some(Recorder::new(
+            options.frame_settings,
+            scene.view(),
+            &scene.name,
+            options.gif.as_deref(),
+            options.frames.as_deref(),
+        )?)
+    } else {
+        None
+    };
 
     let total_steps = (scene.duration / scene.dt).round().max(1.0) as u64;
     let mut particle_steps = 0u64;
-    let start = Instant::now();
+    // The ticks alone: drawing and writing pictures is not the simulation's cost.
+    let mut wall_seconds = 0.0;
     loop {
         let steps = world.resource::<SimulationClock>().steps;
         if steps >= total_steps {
@@ -123,12 +175,32 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         }
         let substeps = (total_steps - steps).min(scene.substeps as u64) as u32;
         world.resource_mut::<StrandsConfig>().substeps = substeps;
+        let tick_start = Instant::now();
         world.run_schedule(StrandsTick);
+        wall_seconds += tick_start.elapsed().as_secs_f64();
         particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
         progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
+        if let Some(recorder) = &mut recorder {
+            recorder.capture_if_due(world)?;
+        }
     }
-    let wall_seconds = start.elapsed().as_secs_f64();
-    Ok(report(world, &scene, wall_seconds, particle_steps))
+    let mut report = report(world, &scene, wall_seconds, particle_steps);
+    if let Some(recorder) = recorder {
+        let frames = recorder.finish()?;
+        for (kind, path) in [("GIF", &options.gif), ("PNG frames", &options.frames)] {
+            if let Some(path) = path {
+                report
+                    .pictures
+                    .push(format!("{kind}: {} ({frames} frames)", path.display()));
+            }
+        }
+    }
+    if let Some(path) = &options.plot {
+        let history = world.resource::<LengthErrorHistory>();
+        plot_length_error(path, &scene.name, &history.samples, (900, 500))?;
+        report.pictures.push(format!("plot: {}", path.display()));
+    }
+    Ok(report)
 }
 
 fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) -> Report {
@@ -140,6 +212,13 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         notes.push(
             "solver springs: no constraints; every edge is a stretch spring, so lengths \
              follow the spring stiffness"
+                .to_string(),
+        );
+    }
+    if !world.resource::<CollisionConfig>().enabled {
+        notes.push(
+            "collisions are off in this run: edges may pass through each other, and \
+             edge_crossings counts the steps at which some did"
                 .to_string(),
         );
     }
@@ -189,5 +268,6 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         },
         notes,
         input_problems,
+        pictures: Vec::new(),
     }
 }

@@ -21,7 +21,7 @@ use bevy::time::Fixed;
 use crate::config::StrandsConfig;
 use crate::forces::accumulate_forces;
 use crate::integrate::{integrate, predict};
-use crate::metrics::{StrandMetrics, count_elements, measure};
+use crate::metrics::{StrandMetrics, count_elements, measure, record_length_error_history};
 use crate::state::{gather, write_back};
 use crate::topology::{detect_strand_edits, rebuild_topology, topology_dirty};
 
@@ -135,7 +135,7 @@ impl Plugin for SchedulePlugin {
                     .after(rebuild_topology),
                 gather.in_set(TickSet::Gather),
                 run_steps.in_set(TickSet::Step),
-                write_back.in_set(TickSet::Writeback),
+                (write_back, record_length_error_history).in_set(TickSet::Writeback),
             ),
         );
         app.add_systems(
@@ -158,6 +158,11 @@ impl Plugin for SchedulePlugin {
 /// Run `substeps` steps and account their wall time.
 fn run_steps(world: &mut World) {
     let substeps = world.resource::<StrandsConfig>().substeps;
+    {
+        let mut metrics = world.resource_mut::<StrandMetrics>();
+        metrics.tick_max_rel_length_error = 0.0;
+        metrics.tick_max_rel_length_error_free = 0.0;
+    }
     let start = Instant::now();
     world.schedule_scope(StrandsStep, |world, schedule| {
         for _ in 0..substeps {

@@ -225,6 +225,7 @@ pub struct StrandBuilder {
     closed: bool,
     mass: f64,
     velocity: DVec2,
+    velocities: Option<Vec<DVec2>>,
     pinned: Vec<usize>,
     rest_lengths: Option<Vec<f64>>,
     rest_shape_from_points: bool,
@@ -240,6 +241,7 @@ impl StrandBuilder {
             closed: false,
             mass: 1.0,
             velocity: DVec2::ZERO,
+            velocities: None,
             pinned: Vec::new(),
             rest_lengths: None,
             rest_shape_from_points: false,
@@ -274,6 +276,12 @@ impl StrandBuilder {
     /// Initial velocity of every particle.
     pub fn velocity(mut self, velocity: DVec2) -> Self {
         self.velocity = velocity;
+        self
+    }
+
+    /// Initial velocity of each particle, in order (overrides [`StrandBuilder::velocity`]).
+    pub fn velocities(mut self, velocities: Vec<DVec2>) -> Self {
+        self.velocities = Some(velocities);
         self
     }
 
@@ -346,6 +354,24 @@ impl StrandBuilder {
                 value: self.velocity,
             });
         }
+        if let Some(velocities) = &self.velocities {
+            if velocities.len() != n {
+                return Err(StrandError::WrongLength {
+                    what: "velocities",
+                    got: velocities.len(),
+                    expected: n,
+                });
+            }
+            if let Some((index, &value)) =
+                velocities.iter().enumerate().find(|(_, v)| !v.is_finite())
+            {
+                return Err(StrandError::NotFinite {
+                    what: "velocity",
+                    index,
+                    value,
+                });
+            }
+        }
         if !(self.mass.is_finite() && self.mass > 0.0) {
             return Err(StrandError::BadMass {
                 index: 0,
@@ -394,10 +420,11 @@ impl StrandBuilder {
             .iter()
             .enumerate()
             .map(|(i, &p)| {
+                let velocity = self.velocities.as_ref().map_or(self.velocity, |v| v[i]);
                 let mut particle = commands.spawn((
                     Particle,
                     Position(p),
-                    Velocity(self.velocity),
+                    Velocity(velocity),
                     Mass(self.mass),
                     StrandOf(strand),
                 ));

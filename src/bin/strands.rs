@@ -1,13 +1,16 @@
 //! `strands`: run a canonical scenario headless and print its report.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 use bevy_strands::constraints::SolverKind;
+use bevy_strands::export::FrameSettings;
 use bevy_strands::runner::{RunOptions, run};
 use bevy_strands::scenes::BUILTIN_SCENES;
 use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser)]
 #[command(
@@ -25,7 +28,7 @@ enum Command {
     /// List the built-in scenarios.
     List,
     /// Run a scenario and print its report.
-    Run(RunArgs),
+    Run(Box<RunArgs>),
 }
 
 #[derive(clap::Args)]
@@ -64,6 +67,39 @@ struct RunArgs {
     /// Do not count edge crossings (the report then says null, not 0).
     #[arg(long)]
     no_check: bool,
+    /// Turn collisions off.
+    #[arg(long)]
+    no_collisions: bool,
+    /// Strands of the scale scenario.
+    #[arg(long, value_name = "S")]
+    strands: Option<usize>,
+    /// Particles per strand of the scale scenario.
+    #[arg(long, value_name = "P")]
+    particles: Option<usize>,
+    /// Write an animated GIF of the run.
+    #[arg(long, value_name = "FILE")]
+    gif: Option<PathBuf>,
+    /// Write numbered PNG frames of the run into this directory.
+    #[arg(long, value_name = "DIR")]
+    frames: Option<PathBuf>,
+    /// Frames per simulated second of --gif and --frames.
+    #[arg(long, value_name = "N", default_value_t = 30.0)]
+    fps: f64,
+    /// Frame size of --gif and --frames, in pixels.
+    #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Write a plot of the largest relative length error over time (PNG).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let parse = |part: Option<&str>| part.and_then(|p| p.trim().parse::<u32>().ok());
+    let mut parts = text.split(['x', 'X']);
+    match (parse(parts.next()), parse(parts.next()), parts.next()) {
+        (Some(w), Some(h), None) => Ok((w, h)),
+        _ => Err(format!("'{text}' is not a size like 512x512")),
+    }
 }
 
 fn solver_help() -> String {
@@ -104,8 +140,43 @@ fn main() -> ExitCode {
                 stretch_springs: args.stretch_springs,
                 start_of_step: args.start_of_step,
                 check_crossings: !args.no_check,
+                no_collisions: args.no_collisions,
+                strands: args.strands,
+                particles: args.particles,
+                gif: args.gif,
+                frames: args.frames,
+                plot: args.plot,
+                frame_settings: FrameSettings {
+                    fps: args.fps,
+                    width: args.size.0,
+                    height: args.size.1,
+                },
             };
-            match run(&options, |_| {}) {
+            // A progress bar on stderr for runs longer than a second; none with --json
+            // when stderr is not a terminal.
+            let quiet = args.json && !std::io::stderr().is_terminal();
+            let started = Instant::now();
+            let mut bar: Option<ProgressBar> = None;
+            let result = run(&options, |fraction| {
+                if quiet {
+                    return;
+                }
+                if bar.is_none() && started.elapsed() > Duration::from_secs(1) {
+                    let style = ProgressStyle::with_template(
+                        "{elapsed_precise} [{bar:40}] {percent:>3}% eta {eta}",
+                    )
+                    .expect("a valid template")
+                    .progress_chars("=> ");
+                    bar = Some(ProgressBar::new(1000).with_style(style));
+                }
+                if let Some(bar) = &bar {
+                    bar.set_position((fraction * 1000.0) as u64);
+                }
+            });
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+            match result {
                 Ok(report) if args.json => {
                     emit(&format!("{}\n", report.to_json()));
                     ExitCode::SUCCESS

@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::constraints::SolverKind;
+use crate::export::raster::View;
 use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
 
 /// A problem with a scene file: which file, which item in it, and what is wrong.
@@ -75,6 +76,83 @@ pub struct Scene {
     /// A spaghetti factory.
     #[serde(default)]
     pub spaghetti_factory: Option<SpaghettiFactorySpec>,
+    /// A meatball factory.
+    #[serde(default)]
+    pub meatball_factory: Option<MeatballFactorySpec>,
+    /// A furry creature.
+    #[serde(default)]
+    pub furry_creature: Option<FurryCreatureSpec>,
+    /// A throughput test: many strands dropped into a box sized for them (replaces
+    /// `container`).
+    #[serde(default)]
+    pub scale: Option<ScaleSpec>,
+}
+
+/// The meatball factory (see [`MeatballFactory`](crate::scenes::meatball_factory::MeatballFactory)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeatballFactorySpec {
+    /// Seconds between drops.
+    pub interval: f64,
+    /// Simulated time of the first drop.
+    #[serde(default)]
+    pub start: f64,
+    /// Side of the triangles.
+    pub side: f64,
+    /// Height the triangles' centres are dropped from.
+    pub height: f64,
+    /// x of the first drop.
+    pub first_x: f64,
+    /// x step between drops.
+    pub step_x: f64,
+    /// Drops past this x wrap around by whole steps...
+    pub wrap_x: f64,
+    /// ...to the lowest drop point at or above this x.
+    pub low_x: f64,
+    /// Initial falling speed.
+    pub speed: f64,
+    /// Spin (rad/s), alternating in sign from drop to drop.
+    pub spin: f64,
+    /// Triangles at most.
+    pub max: usize,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+/// The furry creature (see [`FurryCreature`](crate::scenes::furry_creature::FurryCreature)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FurryCreatureSpec {
+    /// Centre of the body's circular path.
+    pub centre: [f64; 2],
+    /// Radius of the path.
+    pub path_radius: f64,
+    /// Seconds per turn of the path.
+    pub period: f64,
+    /// Radius of the body.
+    pub body_radius: f64,
+    /// Hairs, evenly spaced around the rim.
+    pub hairs: usize,
+    /// Particles per hair.
+    pub particles_per_hair: usize,
+    /// Rest spacing of the hairs' particles.
+    pub spacing: f64,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+/// The scale scenario's strands.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleSpec {
+    /// Strands.
+    pub strands: usize,
+    /// Particles per strand.
+    pub particles: usize,
+    /// Rest spacing.
+    pub spacing: f64,
 }
 
 /// The spaghetti factory (see [`SpaghettiFactory`](crate::scenes::spaghetti_factory::SpaghettiFactory)).
@@ -383,6 +461,22 @@ impl Scene {
         Self::parse(&text, &file)
     }
 
+    /// The rectangle pictures show: the container (the scale scenario's included), or
+    /// the unit box.
+    pub fn view(&self) -> View {
+        let container = self.scale.map(|s| s.container()).or(self.container);
+        match container {
+            Some(c) => View {
+                min: vec2(c.min),
+                max: vec2(c.max),
+            },
+            None => View {
+                min: DVec2::ZERO,
+                max: DVec2::ONE,
+            },
+        }
+    }
+
     /// The constraint solver the scene asks for.
     pub fn solver_kind(&self) -> Result<SolverKind, String> {
         self.solver.parse()
@@ -446,6 +540,67 @@ impl Scene {
                     format!(
                         "a strand needs at least 2 particles, got {}",
                         f.particles_per_strand
+                    ),
+                ));
+            }
+        }
+        if let Some(m) = &self.meatball_factory {
+            let at = |field: &str| format!("meatball_factory.{field}");
+            for (field, value) in [
+                ("interval", m.interval),
+                ("side", m.side),
+                ("step_x", m.step_x),
+                ("mass", m.mass),
+            ] {
+                positive(field, value).map_err(|p| fail(&at(field), p))?;
+            }
+            for (field, value) in [
+                ("start", m.start),
+                ("height", m.height),
+                ("first_x", m.first_x),
+                ("wrap_x", m.wrap_x),
+                ("low_x", m.low_x),
+                ("speed", m.speed),
+                ("spin", m.spin),
+            ] {
+                if !value.is_finite() {
+                    return Err(fail(&at(field), format!("{value} is not finite")));
+                }
+            }
+        }
+        if let Some(f) = &self.furry_creature {
+            let at = |field: &str| format!("furry_creature.{field}");
+            finite2(f.centre).map_err(|p| fail(&at("centre"), p))?;
+            for (field, value) in [
+                ("period", f.period),
+                ("body_radius", f.body_radius),
+                ("spacing", f.spacing),
+                ("mass", f.mass),
+            ] {
+                positive(field, value).map_err(|p| fail(&at(field), p))?;
+            }
+            non_negative(f.path_radius).map_err(|p| fail(&at("path_radius"), p))?;
+            if f.particles_per_hair < 3 {
+                return Err(fail(
+                    &at("particles_per_hair"),
+                    format!(
+                        "a hair needs at least 3 particles (two are its root), got {}",
+                        f.particles_per_hair
+                    ),
+                ));
+            }
+        }
+        if let Some(scale) = &self.scale {
+            positive("spacing", scale.spacing).map_err(|p| fail("scale.spacing", p))?;
+            if scale.strands == 0 {
+                return Err(fail("scale.strands", "must be at least 1".into()));
+            }
+            if scale.particles < 2 {
+                return Err(fail(
+                    "scale.particles",
+                    format!(
+                        "a strand needs at least 2 particles, got {}",
+                        scale.particles
                     ),
                 ));
             }
@@ -532,6 +687,49 @@ impl StrandSpec {
             .validate()
             .map(|_| ())
             .map_err(|e| (String::new(), e.to_string()))
+    }
+}
+
+impl ScaleSpec {
+    /// Strands per row of the initial arrangement.
+    pub fn columns(&self) -> usize {
+        ((self.strands as f64 / 8.0).sqrt().ceil() as usize).max(1)
+    }
+
+    /// Length of one strand.
+    pub fn strand_length(&self) -> f64 {
+        (self.particles - 1) as f64 * self.spacing
+    }
+
+    /// Horizontal and vertical pitch of the arrangement.
+    pub fn pitch(&self) -> DVec2 {
+        DVec2::new(
+            self.strand_length() + 5.0 * self.spacing,
+            4.0 * self.spacing,
+        )
+    }
+
+    /// The box the strands start in and fall into.
+    pub fn container(&self) -> ContainerSpec {
+        let rows = self.strands.div_ceil(self.columns());
+        let pitch = self.pitch();
+        ContainerSpec {
+            min: [0.0, 0.0],
+            max: [
+                self.columns() as f64 * pitch.x + 2.0 * self.spacing,
+                (rows as f64 + 2.0) * pitch.y,
+            ],
+        }
+    }
+
+    /// First particle of strand `s`; strands run along +x.
+    pub fn start(&self, s: usize) -> DVec2 {
+        let (row, column) = (s / self.columns(), s % self.columns());
+        let pitch = self.pitch();
+        DVec2::new(
+            3.5 * self.spacing + column as f64 * pitch.x,
+            (row as f64 + 1.5) * pitch.y,
+        )
     }
 }
 

@@ -9,6 +9,8 @@ use crate::config::StrandsConfig;
 use crate::constraints::ConstraintConfig;
 use crate::constraints::projection::ConstraintDirection;
 use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
+use crate::scenes::furry_creature::{FurryCreature, spawn_furry_creature};
+use crate::scenes::meatball_factory::MeatballFactory;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
 use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
 
@@ -50,7 +52,25 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
         collisions.contact_passes = scene.collisions.contact_passes;
     }
 
-    if let Some(container) = &scene.container {
+    if let Some(scale) = &scene.scale {
+        let container = scale.container();
+        container_builder(vec2(container.min), vec2(container.max))
+            .spawn_in(world)
+            .map_err(|e| fail("scale".into(), e.to_string()))?;
+        let step = DVec2::new(scale.spacing, 0.0);
+        for s in 0..scale.strands {
+            let start = scale.start(s);
+            // A gentle wave so that strands do not land perfectly flat on each other.
+            let points = (0..scale.particles).map(|i| {
+                let wave = 0.5 * scale.spacing * ((i + 3 * s) as f64 * 0.4).sin();
+                start + step * i as f64 + DVec2::new(0.0, wave)
+            });
+            StrandBuilder::polyline(points)
+                .kind(StrandKind::Rope)
+                .spawn_in(world)
+                .map_err(|e| fail(format!("scale strand {s}"), e.to_string()))?;
+        }
+    } else if let Some(container) = &scene.container {
         container_builder(vec2(container.min), vec2(container.max))
             .spawn_in(world)
             .map_err(|e| fail("container".into(), e.to_string()))?;
@@ -72,6 +92,35 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
         factory.mass = f.mass;
         factory.max_strands = f.max_strands;
         world.spawn(factory);
+    }
+    if let Some(m) = &scene.meatball_factory {
+        world.spawn(MeatballFactory {
+            interval: m.interval,
+            side: m.side,
+            height: m.height,
+            drop_x: m.first_x,
+            step_x: m.step_x,
+            wrap_x: m.wrap_x,
+            low_x: m.low_x,
+            speed: m.speed,
+            spin: m.spin,
+            max: m.max,
+            mass: m.mass,
+            next_drop: m.start,
+            dropped: 0,
+            skipped: 0,
+        });
+    }
+    if let Some(f) = &scene.furry_creature {
+        let creature = FurryCreature::new(vec2(f.centre), f.path_radius, f.period, f.body_radius);
+        spawn_furry_creature(
+            world,
+            creature,
+            f.hairs,
+            f.particles_per_hair,
+            f.spacing,
+            f.mass,
+        );
     }
     for particle in &scene.particles {
         let mut entity = world.spawn((

@@ -2,12 +2,18 @@
 //! runner works from anywhere (their text is the scene file under `assets/scenes/`),
 //! and the scenario logic that runs during a simulation (factories).
 
+pub mod furry_creature;
+pub mod meatball_factory;
 pub mod spaghetti_factory;
 
 use bevy::prelude::*;
 
+use crate::export::Disc;
+use crate::forces::accumulate_forces;
 use crate::scene::{Scene, SceneError};
-use crate::schedule::{StrandsTick, TickSet};
+use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
+use furry_creature::{FurryCreature, drive_furry_creatures};
+use meatball_factory::{MeatballFactory, run_meatball_factories};
 use spaghetti_factory::{SpaghettiFactory, run_spaghetti_factories};
 
 /// Scenario logic: factories and other scripted sources.
@@ -15,10 +21,22 @@ pub struct ScenesPlugin;
 
 impl Plugin for ScenesPlugin {
     fn build(&self, app: &mut App) {
-        app.register_type::<SpaghettiFactory>().add_systems(
-            StrandsTick,
-            run_spaghetti_factories.in_set(TickSet::Prepare),
-        );
+        app.register_type::<SpaghettiFactory>()
+            .register_type::<MeatballFactory>()
+            .register_type::<FurryCreature>()
+            .register_type::<Disc>()
+            .add_systems(
+                StrandsTick,
+                (run_spaghetti_factories, run_meatball_factories)
+                    .chain()
+                    .in_set(TickSet::Prepare),
+            )
+            .add_systems(
+                StrandsStep,
+                drive_furry_creatures
+                    .in_set(StepSet::Forces)
+                    .after(accumulate_forces),
+            );
     }
 }
 
@@ -51,6 +69,21 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         name: "spaghetti_factory",
         file: "assets/scenes/spaghetti_factory.ron",
         text: include_str!("../../assets/scenes/spaghetti_factory.ron"),
+    },
+    BuiltinScene {
+        name: "meatball_factory",
+        file: "assets/scenes/meatball_factory.ron",
+        text: include_str!("../../assets/scenes/meatball_factory.ron"),
+    },
+    BuiltinScene {
+        name: "furry_creature",
+        file: "assets/scenes/furry_creature.ron",
+        text: include_str!("../../assets/scenes/furry_creature.ron"),
+    },
+    BuiltinScene {
+        name: "scale",
+        file: "assets/scenes/scale.ron",
+        text: include_str!("../../assets/scenes/scale.ron"),
     },
 ];
 
