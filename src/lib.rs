@@ -40,6 +40,7 @@ pub mod scenes;
 pub mod schedule;
 pub mod state;
 pub mod strand;
+pub mod tools;
 pub mod topology;
 
 use bevy::app::PluginGroupBuilder;
@@ -138,6 +139,7 @@ impl Plugin for StrandsCorePlugin {
             .register_type::<strand::Strand>()
             .register_type::<strand::StrandMaterial>()
             .register_type::<strand::StrandKind>()
+            .register_type::<forces::tether::Tether>()
             .add_plugins(SchedulePlugin {
                 driver: self.driver,
             });

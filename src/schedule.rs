@@ -20,6 +20,7 @@ use bevy::time::Fixed;
 
 use crate::config::StrandsConfig;
 use crate::forces::accumulate_forces;
+use crate::forces::tether::apply_tethers;
 use crate::integrate::{integrate, predict};
 use crate::metrics::{StrandMetrics, count_elements, measure, record_length_error_history};
 use crate::state::{gather, write_back};
@@ -141,7 +142,9 @@ impl Plugin for SchedulePlugin {
         app.add_systems(
             StrandsStep,
             (
-                accumulate_forces.in_set(StepSet::Forces),
+                (accumulate_forces, apply_tethers)
+                    .chain()
+                    .in_set(StepSet::Forces),
                 predict.in_set(StepSet::Predict),
                 integrate.in_set(StepSet::Integrate),
                 measure.in_set(StepSet::Measure),

@@ -10,7 +10,7 @@
 use std::collections::HashSet;
 use std::ops::Range;
 
-use bevy::ecs::entity::{EntityHashMap, EntityHashSet};
+use bevy::ecs::entity::EntityHashMap;
 use bevy::ecs::world::DeferredWorld;
 use bevy::prelude::*;
 
@@ -371,77 +371,71 @@ fn strand_problem(strand: &Strand, valid: &EntityHashMap<bool>) -> Option<String
 /// Split every strand that lists a despawned particle into the runs of particles that
 /// still exist, so that no strand is left referencing a dead entity.
 fn split_strands_with_missing_particles(world: &mut World) {
-    let mut strands = world.query::<(
-        Entity,
-        &Strand,
-        Option<&StrandKind>,
-        Option<&StrandMaterial>,
-    )>();
-    let broken: Vec<_> = strands
+    let mut strands = world.query::<(Entity, &Strand)>();
+    let broken: Vec<(Entity, Vec<Entity>)> = strands
         .iter(world)
-        .filter(|(_, strand, ..)| {
-            strand
+        .filter_map(|(entity, strand)| {
+            let missing: Vec<Entity> = strand
                 .particles
                 .iter()
-                .any(|&p| world.get_entity(p).is_err())
-        })
-        .map(|(entity, strand, kind, material)| {
-            (entity, strand.clone(), kind.copied(), material.copied())
+                .copied()
+                .filter(|&p| world.get_entity(p).is_err())
+                .collect();
+            (!missing.is_empty()).then_some((entity, missing))
         })
         .collect();
-
-    for (entity, strand, kind, material) in broken {
-        let alive: EntityHashSet = strand
-            .particles
-            .iter()
-            .copied()
-            .filter(|&p| world.get_entity(p).is_ok())
-            .collect();
-        let exists = |p: Entity| alive.contains(&p);
-        let missing: Vec<Entity> = strand
-            .particles
-            .iter()
-            .copied()
-            .filter(|&p| !exists(p))
-            .collect();
-        let pieces = split_around(&strand, exists);
+    for (entity, missing) in broken {
+        let pieces = split_strand(world, entity, |p| !missing.contains(&p));
         let message = format!(
-            "strand referenced despawned particle(s) {missing:?}; split into {} strand(s)",
-            pieces.len()
+            "strand referenced despawned particle(s) {missing:?}; split into {pieces} strand(s)"
         );
         world
             .get_resource_or_insert_with(InputProblems::default)
             .report(entity, message);
+    }
+}
 
-        let owned_by = |world: &World, p: Entity| {
-            world
-                .get::<StrandOf>(p)
-                .is_some_and(|owner| owner.0 == entity)
-        };
-        let Some((first, rest)) = pieces.split_first() else {
-            // Nothing left to join: free the survivors so they outlive the strand.
-            for &p in &strand.particles {
-                if exists(p) && owned_by(world, p) {
-                    world.entity_mut(p).remove::<StrandOf>();
-                }
-            }
-            world.entity_mut(entity).despawn();
-            continue;
-        };
-        for piece in rest {
-            let mut spawned = world.spawn((piece.clone(), kind.unwrap_or_default()));
-            if let Some(material) = material {
-                spawned.insert(material);
-            }
-            let new = spawned.id();
-            for &p in &piece.particles {
-                if owned_by(world, p) {
-                    world.entity_mut(p).insert(StrandOf(new));
-                }
+/// Split strand `entity` into the runs of its particles for which `keep` holds: the
+/// first run stays on `entity`, the others become new strands (with the same kind and
+/// material, owning their particles). With no run of two particles left, the strand is
+/// despawned and the particles it owned that are kept outlive it. Returns the number of
+/// strands left.
+pub fn split_strand(world: &mut World, entity: Entity, keep: impl Fn(Entity) -> bool) -> usize {
+    let Some(strand) = world.get::<Strand>(entity).cloned() else {
+        return 0;
+    };
+    let kind = world.get::<StrandKind>(entity).copied();
+    let material = world.get::<StrandMaterial>(entity).copied();
+    let pieces = split_around(&strand, &keep);
+    let owned_by = |world: &World, p: Entity| {
+        world
+            .get::<StrandOf>(p)
+            .is_some_and(|owner| owner.0 == entity)
+    };
+    let Some((first, rest)) = pieces.split_first() else {
+        // Nothing left to join: free the survivors so they outlive the strand.
+        for &p in &strand.particles {
+            if keep(p) && world.get_entity(p).is_ok() && owned_by(world, p) {
+                world.entity_mut(p).remove::<StrandOf>();
             }
         }
-        world.entity_mut(entity).insert(first.clone());
+        world.entity_mut(entity).despawn();
+        return 0;
+    };
+    for piece in rest {
+        let mut spawned = world.spawn((piece.clone(), kind.unwrap_or_default()));
+        if let Some(material) = material {
+            spawned.insert(material);
+        }
+        let new = spawned.id();
+        for &p in &piece.particles {
+            if owned_by(world, p) {
+                world.entity_mut(p).insert(StrandOf(new));
+            }
+        }
     }
+    world.entity_mut(entity).insert(first.clone());
+    pieces.len()
 }
 
 /// The runs of consecutive vertices for which `keep` holds, as open strands of at

@@ -3,12 +3,14 @@
 //! module; [`accumulate_forces`] is the thin system that runs them in a fixed order.
 //!
 //! User forces go in [`StepSet::Forces`](crate::schedule::StepSet::Forces) after
-//! [`accumulate_forces`], adding to the accumulator.
+//! [`accumulate_forces`] (and [`tether::apply_tethers`], the mouse drag's spring), adding
+//! to the accumulator.
 
 pub mod bending;
 pub mod damping;
 pub mod gravity;
 pub mod springs;
+pub mod tether;
 
 use bevy::prelude::*;
 

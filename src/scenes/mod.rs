@@ -9,7 +9,7 @@ pub mod spaghetti_factory;
 use bevy::prelude::*;
 
 use crate::export::Disc;
-use crate::forces::accumulate_forces;
+use crate::forces::tether::apply_tethers;
 use crate::scene::{Scene, SceneError};
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
 use furry_creature::{FurryCreature, drive_furry_creatures};
@@ -35,7 +35,7 @@ impl Plugin for ScenesPlugin {
                 StrandsStep,
                 drive_furry_creatures
                     .in_set(StepSet::Forces)
-                    .after(accumulate_forces),
+                    .after(apply_tethers),
             );
     }
 }
