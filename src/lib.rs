@@ -33,6 +33,8 @@ pub mod forces;
 pub mod integrate;
 pub mod metrics;
 pub mod particle;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod report;
 pub mod runner;
 pub mod scene;

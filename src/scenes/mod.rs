@@ -85,6 +85,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         file: "assets/scenes/scale.ron",
         text: include_str!("../../assets/scenes/scale.ron"),
     },
+    BuiltinScene {
+        name: "sandbox",
+        file: "assets/scenes/sandbox.ron",
+        text: include_str!("../../assets/scenes/sandbox.ron"),
+    },
 ];
 
 /// The built-in scenario called `name`.

@@ -1,0 +1,20 @@
+//! A body on a circular path drags 400 hairs rooted on its rim.
+//!
+//! `cargo run --release --example furry_creature --features render`. The panel on the right
+//! holds the controls, the live figures and the mouse tools.
+
+use bevy::prelude::*;
+use bevy_strands::prelude::*;
+use bevy_strands::render::{ActiveScene, StrandsRenderPlugin, StrandsUiPlugin, window_plugins};
+
+fn main() -> AppExit {
+    App::new()
+        .add_plugins(window_plugins("furry creature"))
+        .add_plugins((
+            StrandsPlugin::default(),
+            StrandsRenderPlugin,
+            StrandsUiPlugin,
+        ))
+        .insert_resource(ActiveScene::builtin("furry_creature"))
+        .run()
+}

@@ -1,0 +1,20 @@
+//! The spaghetti factory: an inlet extrudes strands that pile up in the box.
+//!
+//! `cargo run --release --example spaghetti_factory --features render`. The panel on the right
+//! holds the controls, the live figures and the mouse tools.
+
+use bevy::prelude::*;
+use bevy_strands::prelude::*;
+use bevy_strands::render::{ActiveScene, StrandsRenderPlugin, StrandsUiPlugin, window_plugins};
+
+fn main() -> AppExit {
+    App::new()
+        .add_plugins(window_plugins("spaghetti factory"))
+        .add_plugins((
+            StrandsPlugin::default(),
+            StrandsRenderPlugin,
+            StrandsUiPlugin,
+        ))
+        .insert_resource(ActiveScene::builtin("spaghetti_factory"))
+        .run()
+}
