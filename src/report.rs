@@ -2,6 +2,23 @@
 
 use serde::Serialize;
 
+/// Constraint islands by kind and by the solver that took them.
+#[derive(Serialize, Clone, Debug, Default, PartialEq)]
+pub struct IslandReport {
+    /// Chains (open strands, or pieces between pins): Thomas.
+    pub path: usize,
+    /// Loops: Sherman–Morrison on top of Thomas.
+    pub cycle: usize,
+    /// Branching islands.
+    pub tree: usize,
+    /// Islands with several loops or redundant edges.
+    pub graph: usize,
+    /// Islands the configured solver could not take; their edges are stretch springs.
+    pub unsolved: usize,
+    /// The solver of each kind, e.g. `path: thomas`.
+    pub solvers: Vec<String>,
+}
+
 /// Figures of one headless run.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct Report {
@@ -21,6 +38,8 @@ pub struct Report {
     pub strands: usize,
     /// Edges kept at rest length by the constraint solver at the end.
     pub constrained_edges: usize,
+    /// The constraint islands at the end, by kind, and which solver took them.
+    pub islands: IslandReport,
     /// Largest `|ℓ − L| / L` over every non-static edge and every step end.
     pub max_rel_length_error: f64,
     /// The same over edges with no particle in contact that step.
@@ -82,6 +101,17 @@ impl Report {
             ("particles", self.particles.to_string()),
             ("strands", self.strands.to_string()),
             ("constrained_edges", self.constrained_edges.to_string()),
+            (
+                "islands",
+                format!(
+                    "{} path, {} cycle, {} tree, {} graph; {} unsolved",
+                    self.islands.path,
+                    self.islands.cycle,
+                    self.islands.tree,
+                    self.islands.graph,
+                    self.islands.unsolved
+                ),
+            ),
             (
                 "max_rel_length_error",
                 format!("{:.3e}", self.max_rel_length_error),

@@ -10,12 +10,13 @@ use thiserror::Error;
 use crate::StrandsPlugin;
 use crate::collision::CollisionConfig;
 use crate::config::StrandsConfig;
-use crate::constraints::{ConstraintConfig, SolverKind};
+use crate::constraints::islands::IslandKind;
+use crate::constraints::{ConstraintConfig, Islands, SolverKind};
 use crate::export::plot::plot_length_error;
 use crate::export::{ExportError, FrameSettings, Recorder};
 use crate::metrics::LengthErrorHistory;
 use crate::metrics::StrandMetrics;
-use crate::report::Report;
+use crate::report::{IslandReport, Report};
 use crate::scene::{Scene, SceneError, spawn_scene};
 use crate::scenes::{builtin, builtin_names};
 use crate::schedule::{SimulationClock, StrandsTick};
@@ -207,6 +208,27 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
     let metrics = world.resource::<StrandMetrics>();
     let clock = world.resource::<SimulationClock>();
     let solver = world.resource::<ConstraintConfig>().solver;
+    let islands = world.resource::<Islands>();
+    let island_report = IslandReport {
+        path: islands.count(IslandKind::Path),
+        cycle: islands.count(IslandKind::Cycle),
+        tree: islands.count(IslandKind::Tree),
+        graph: islands.count(IslandKind::Graph),
+        unsolved: islands.unsolved.len(),
+        solvers: [
+            IslandKind::Path,
+            IslandKind::Cycle,
+            IslandKind::Tree,
+            IslandKind::Graph,
+        ]
+        .into_iter()
+        .filter(|&kind| islands.count(kind) > 0)
+        .map(|kind| {
+            let method = solver.method(kind).unwrap_or("none: stretch springs");
+            format!("{}: {method}", kind.name())
+        })
+        .collect(),
+    };
     let mut notes = Vec::new();
     if solver == SolverKind::Springs {
         notes.push(
@@ -246,6 +268,7 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
         particles: metrics.particles,
         strands: metrics.strands,
         constrained_edges: metrics.constrained_edges,
+        islands: island_report,
         max_rel_length_error: metrics.max_rel_length_error,
         max_rel_length_error_free: metrics.max_rel_length_error_free,
         edge_crossings: metrics.edge_crossings,

@@ -59,6 +59,15 @@ impl SolverKind {
         }
     }
 
+    /// The method this solver uses on islands of `kind`, if it takes them.
+    pub fn method(self, kind: IslandKind) -> Option<&'static str> {
+        match (self, kind) {
+            (SolverKind::Tridiagonal, IslandKind::Path) => Some("Thomas"),
+            (SolverKind::Tridiagonal, IslandKind::Cycle) => Some("cyclic (Sherman-Morrison)"),
+            _ => None,
+        }
+    }
+
     /// Whether the solver can solve islands of `kind`.
     pub fn solves(self, kind: IslandKind) -> bool {
         match self {

@@ -148,9 +148,15 @@ pub fn draw_frame(pixmap: &mut Pixmap, view: &View, content: &FrameContent) {
         }
     }
 
-    // Pinned particles in red (the wall corners too).
+    // Pinned particles in red (the wall corners too); many pins (hair roots) small, so
+    // that they mark rather than cover.
     let mut dots = PathBuilder::new();
-    let radius = (1.5 * stroke.width).max(2.0);
+    let pins = content.pinned.iter().filter(|&&p| p).count();
+    let radius = if pins > 100 {
+        (0.5 * stroke.width).max(0.75)
+    } else {
+        (1.5 * stroke.width).max(2.0)
+    };
     for (i, &p) in content.position.iter().enumerate() {
         if content.pinned.get(i).copied().unwrap_or(false) {
             let (x, y) = to_pixel(p);
