@@ -42,6 +42,23 @@ pub struct Edge {
     pub damping: f64,
 }
 
+impl Edge {
+    /// A dynamic edge from `a` to `b` with no spring, not yet constrained.
+    pub fn new(a: u32, b: u32, rest_length: f64) -> Self {
+        Self {
+            a,
+            b,
+            rest_length,
+            strand: 0,
+            is_static: false,
+            constrained: false,
+            spring: false,
+            stiffness: 0.0,
+            damping: 0.0,
+        }
+    }
+}
+
 /// A bending element at particle `s` between edges (a, s) and (s, b).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bend {

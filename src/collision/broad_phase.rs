@@ -281,17 +281,7 @@ mod tests {
                 ));
                 x += 0.01 * DVec2::from_angle(rng.random_range(0.0..6.3));
                 if i > 0 {
-                    edges.push(Edge {
-                        a: first + i - 1,
-                        b: first + i,
-                        rest_length: 0.01,
-                        strand: 0,
-                        is_static: false,
-                        constrained: false,
-                        spring: false,
-                        stiffness: 0.0,
-                        damping: 0.0,
-                    });
+                    edges.push(Edge::new(first + i - 1, first + i, 0.01));
                 }
             }
         }

@@ -213,75 +213,25 @@ mod tests {
     #[test]
     fn degenerate_motions_are_handled() {
         let (q, r) = (DVec2::ZERO, DVec2::X);
+        // Against the unit edge along x, at rest.
+        let at_rest = |p: DVec2, dp: DVec2| hit(p, dp, q, DVec2::ZERO, r, DVec2::ZERO);
         // No motion, not touching.
-        assert!(
-            hit(
-                DVec2::new(0.5, 0.1),
-                DVec2::ZERO,
-                q,
-                DVec2::ZERO,
-                r,
-                DVec2::ZERO
-            )
-            .is_none()
-        );
+        assert!(at_rest(DVec2::new(0.5, 0.1), DVec2::ZERO).is_none());
         // Parallel motion beside the edge.
-        assert!(
-            hit(
-                DVec2::new(0.5, 0.1),
-                DVec2::X,
-                q,
-                DVec2::ZERO,
-                r,
-                DVec2::ZERO
-            )
-            .is_none()
-        );
+        assert!(at_rest(DVec2::new(0.5, 0.1), DVec2::X).is_none());
         // Point already on the edge and not moving: a hit at once.
-        let on = hit(
-            DVec2::new(0.3, 0.0),
-            DVec2::ZERO,
-            q,
-            DVec2::ZERO,
-            r,
-            DVec2::ZERO,
-        )
-        .unwrap();
-        assert_eq!(on.time, 0.0);
+        assert_eq!(
+            at_rest(DVec2::new(0.3, 0.0), DVec2::ZERO).unwrap().time,
+            0.0
+        );
         // Sliding along the edge's line into its end.
-        let slide = hit(
-            DVec2::new(-0.5, 0.0),
-            DVec2::new(1.0, 0.0),
-            q,
-            DVec2::ZERO,
-            r,
-            DVec2::ZERO,
-        )
-        .unwrap();
+        let slide = at_rest(DVec2::new(-0.5, 0.0), DVec2::new(1.0, 0.0)).unwrap();
         assert!((slide.time - 0.5).abs() < 1e-12 && slide.alpha == 0.0);
         // Passing exactly through an endpoint.
-        let end = hit(
-            DVec2::new(1.0, 0.5),
-            DVec2::new(0.0, -1.0),
-            q,
-            DVec2::ZERO,
-            r,
-            DVec2::ZERO,
-        )
-        .unwrap();
+        let end = at_rest(DVec2::new(1.0, 0.5), DVec2::new(0.0, -1.0)).unwrap();
         assert!((end.time - 0.5).abs() < 1e-12 && end.alpha == 1.0);
         // Passing just beyond an endpoint.
-        assert!(
-            hit(
-                DVec2::new(1.001, 0.5),
-                DVec2::new(0.0, -1.0),
-                q,
-                DVec2::ZERO,
-                r,
-                DVec2::ZERO
-            )
-            .is_none()
-        );
+        assert!(at_rest(DVec2::new(1.001, 0.5), DVec2::new(0.0, -1.0)).is_none());
         // Both moving together, never meeting.
         let d = DVec2::new(0.3, 0.2);
         assert!(hit(DVec2::new(0.5, 0.1), d, q, d, r, d).is_none());

@@ -284,17 +284,7 @@ mod tests {
     use super::*;
 
     fn edge(a: u32, b: u32) -> Edge {
-        Edge {
-            a,
-            b,
-            rest_length: 1.0,
-            strand: 0,
-            is_static: false,
-            constrained: false,
-            spring: false,
-            stiffness: 0.0,
-            damping: 0.0,
-        }
+        Edge::new(a, b, 1.0)
     }
 
     fn chain_is_connected(set: &IslandSet, island: &Island) {

@@ -37,15 +37,10 @@ mod tests {
 
     fn edge(stiffness: f64, damping: f64) -> Edge {
         Edge {
-            a: 0,
-            b: 1,
-            rest_length: 1.0,
-            strand: 0,
-            is_static: false,
-            constrained: false,
             spring: true,
             stiffness,
             damping,
+            ..Edge::new(0, 1, 1.0)
         }
     }
 
