@@ -158,8 +158,16 @@ impl Plugin for SchedulePlugin {
     }
 }
 
+/// While set, a tick only synchronises (topology, gather, write-back) and takes no step:
+/// what a paused simulation runs, so that edits made while paused show at once.
+#[derive(Resource, Default, Clone, Copy, Debug)]
+struct SyncOnly(bool);
+
 /// Run `substeps` steps and account their wall time.
 fn run_steps(world: &mut World) {
+    if world.get_resource::<SyncOnly>().is_some_and(|s| s.0) {
+        return;
+    }
     let substeps = world.resource::<StrandsConfig>().substeps;
     {
         let mut metrics = world.resource_mut::<StrandMetrics>();
@@ -178,11 +186,12 @@ fn run_steps(world: &mut World) {
     metrics.last_tick_seconds = seconds;
 }
 
-/// Run one tick unless paused (the driver schedule's system).
+/// Run one tick (the driver schedule's system); paused, one that takes no step.
 fn drive_tick(world: &mut World) {
-    if !world.resource::<StrandsConfig>().paused {
-        world.run_schedule(StrandsTick);
-    }
+    let paused = world.resource::<StrandsConfig>().paused;
+    world.insert_resource(SyncOnly(paused));
+    world.run_schedule(StrandsTick);
+    world.insert_resource(SyncOnly(false));
 }
 
 /// Keep the fixed timestep equal to the simulated time of one tick.

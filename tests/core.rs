@@ -317,3 +317,22 @@ fn an_invalid_strand_component_is_left_out_with_a_message() {
     assert!(message(negative).contains("rest length of edge 0 is -0.1"));
     assert_eq!(app.world().resource::<StrandMetrics>().strands, 0);
 }
+
+#[test]
+fn a_paused_app_keeps_its_state_and_shows_edits() {
+    // Driven by FixedUpdate, as in a game.
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, StrandsPlugin::default()));
+    app.world_mut().resource_mut::<StrandsConfig>().paused = true;
+    let p = spawn_particle(&mut app, DVec2::new(0.5, 0.5), DVec2::ZERO);
+    // Run the fixed loop for a while of wall-clock time.
+    let start = std::time::Instant::now();
+    while start.elapsed() < std::time::Duration::from_millis(150) {
+        app.update();
+    }
+    assert_eq!(position(&app, p), DVec2::new(0.5, 0.5));
+    assert_eq!(app.world().resource::<SimulationClock>().steps, 0);
+    // The paused ticks still synchronised: the new particle is in the packed state.
+    let state = app.world().resource::<ParticleState>();
+    assert_eq!(state.position, vec![DVec2::new(0.5, 0.5)]);
+}
