@@ -1,5 +1,7 @@
-//! Criterion benchmarks of the constraint solve: the Thomas kernel per unknown, and
-//! one Constrain stage (every island projected once) on 1000 strands of 100 particles.
+//! Criterion benchmarks of the constraint solve: the Thomas kernel per unknown, one
+//! Constrain stage (every island projected once) on 1000 strands of 100 particles, and
+//! one projection of a tree and of a graph of about 2000 edges (sparse LDLᵀ) beside a
+//! chain of as many edges.
 //!
 //! Run with `cargo bench --bench constraints`; results per machine are recorded in
 //! `benches/RESULTS.md`.
@@ -8,9 +10,11 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
+use bevy_strands::constraints::graph::GraphLayout;
 use bevy_strands::constraints::islands::IslandEdge;
 use bevy_strands::constraints::projection::{
-    Bodies, Chain, ChainScratch, ConstraintDirection, ProjectionSettings, project_chain,
+    Bodies, Chain, ConstraintDirection, Graph, IslandScratch, IslandView, ProjectionSettings,
+    project_chain, project_island,
 };
 use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -111,8 +115,8 @@ fn constraint_stage(c: &mut Criterion) {
         contact_tolerance: 0.0,
         max_correction: f64::INFINITY,
     };
-    let mut scratch = ChainScratch::default();
-    scratch.reserve(particles);
+    let mut scratch = IslandScratch::default();
+    scratch.reserve(particles, particles + 1);
     let dt = 1.0 / 3000.0;
     group.throughput(Throughput::Elements((strands * particles) as u64));
     group.bench_function(BenchmarkId::new("1000x100", "end_of_step"), |b| {
@@ -149,9 +153,121 @@ fn constraint_stage(c: &mut Criterion) {
     group.finish();
 }
 
+/// Particles and edges (rest lengths from the positions) of a structure.
+struct Structure {
+    position: Vec<DVec2>,
+    edges: Vec<IslandEdge>,
+}
+
+impl Structure {
+    fn new(position: Vec<DVec2>, pairs: &[(u32, u32)]) -> Structure {
+        let edges = pairs
+            .iter()
+            .enumerate()
+            .map(|(k, &(a, b))| IslandEdge {
+                a,
+                b,
+                rest_length: position[a as usize].distance(position[b as usize]),
+                edge: k as u32,
+            })
+            .collect();
+        Structure { position, edges }
+    }
+}
+
+/// A chain of 1999 edges; a comb (a spine of 1000 edges with a tooth of 10 edges at
+/// every tenth particle: 1999 edges, a tree); a ladder (two rails of 1000 particles
+/// and 100 rungs: 2098 edges, a graph of 99 loops).
+fn structures() -> Vec<(&'static str, Structure)> {
+    let spacing = 0.01;
+    let chain = Structure::new(
+        (0..2000)
+            .map(|i| DVec2::new(spacing * i as f64, 0.0))
+            .collect(),
+        &(0..1999).map(|i| (i, i + 1)).collect::<Vec<_>>(),
+    );
+    let mut comb_points: Vec<DVec2> = (0..1001)
+        .map(|i| DVec2::new(spacing * i as f64, 0.0))
+        .collect();
+    let mut comb_pairs: Vec<(u32, u32)> = (0..1000).map(|i| (i, i + 1)).collect();
+    for root in (0..1000).step_by(10) {
+        let mut previous = root as u32;
+        for j in 1..=10 {
+            comb_points.push(DVec2::new(spacing * root as f64, -spacing * j as f64));
+            let next = comb_points.len() as u32 - 1;
+            comb_pairs.push((previous, next));
+            previous = next;
+        }
+    }
+    let comb = Structure::new(comb_points, &comb_pairs);
+    let mut ladder_points: Vec<DVec2> = (0..1000)
+        .map(|i| DVec2::new(spacing * i as f64, 0.0))
+        .collect();
+    ladder_points.extend((0..1000).map(|i| DVec2::new(spacing * i as f64, 0.02)));
+    let mut ladder_pairs: Vec<(u32, u32)> = (0..999).map(|i| (i, i + 1)).collect();
+    ladder_pairs.extend((1000..1999).map(|i| (i, i + 1)));
+    ladder_pairs.extend((0..1000).step_by(10).map(|i| (i, i + 1000)));
+    let ladder = Structure::new(ladder_points, &ladder_pairs);
+    vec![("chain", chain), ("tree", comb), ("graph", ladder)]
+}
+
+fn structure_projection(c: &mut Criterion) {
+    let mut group = c.benchmark_group("projection_by_kind");
+    let mut rng = StdRng::seed_from_u64(3);
+    let settings = ProjectionSettings {
+        tolerance: 1e-12,
+        max_iterations: 20,
+        direction: ConstraintDirection::EndOfStep,
+        contact_tolerance: 0.0,
+        max_correction: f64::INFINITY,
+    };
+    let dt = 1.0 / 3000.0;
+    for (name, mut structure) in structures() {
+        let n = structure.position.len();
+        let layout =
+            (name != "chain").then(|| GraphLayout::new(&mut structure.edges, &vec![false; n]));
+        let initial: Vec<DVec2> = (0..n)
+            .map(|_| DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)))
+            .collect();
+        let inverse_mass = vec![1.0; n];
+        let mut velocity = initial.clone();
+        let mut scratch = IslandScratch::default();
+        group.throughput(Throughput::Elements(structure.edges.len() as u64));
+        group.bench_function(BenchmarkId::new(name, structure.edges.len()), |b| {
+            b.iter(|| {
+                velocity.copy_from_slice(&initial);
+                let island = match &layout {
+                    Some(layout) => IslandView::Graph(Graph {
+                        edges: &structure.edges,
+                        layout,
+                    }),
+                    None => IslandView::Chain(Chain {
+                        edges: &structure.edges,
+                        closed: false,
+                    }),
+                };
+                let bodies = Bodies {
+                    position: &structure.position,
+                    velocity: &mut velocity,
+                    inverse_mass: &inverse_mass,
+                };
+                black_box(project_island(
+                    island,
+                    bodies,
+                    &[],
+                    dt,
+                    &settings,
+                    &mut scratch,
+                ))
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(30).measurement_time(Duration::from_secs(4));
-    targets = thomas, constraint_stage
+    targets = thomas, constraint_stage, structure_projection
 }
 criterion_main!(benches);

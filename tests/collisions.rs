@@ -8,33 +8,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::broad_phase::BroadPhaseMethod;
 use bevy_strands::prelude::*;
-use bevy_strands::scene::container_builder;
 use common::*;
-
-/// An app with crossing checks on.
-fn checked_app() -> App {
-    let mut app = app();
-    app.world_mut()
-        .resource_mut::<CollisionConfig>()
-        .check_crossings = true;
-    app.world_mut()
-        .resource_mut::<StrandMetrics>()
-        .edge_crossings = Some(0);
-    app
-}
-
-fn crossings(app: &App) -> u64 {
-    app.world()
-        .resource::<StrandMetrics>()
-        .edge_crossings
-        .unwrap()
-}
-
-fn spawn_box(app: &mut App) {
-    container_builder(DVec2::ZERO, DVec2::ONE)
-        .spawn_in(app.world_mut())
-        .unwrap();
-}
 
 #[test]
 fn a_fast_particle_does_not_tunnel_through_a_thin_pinned_edge() {

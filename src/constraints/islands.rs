@@ -7,6 +7,7 @@
 
 use std::ops::Range;
 
+use super::graph::GraphLayout;
 use crate::topology::Edge;
 
 /// The shape of an island's constraint graph.
@@ -50,7 +51,8 @@ pub struct IslandEdge {
 /// One island: its kind and its edges in [`IslandSet::edges`].
 ///
 /// For a path, edge `k + 1` starts where edge `k` ends; for a cycle, in addition, the
-/// last edge ends where the first starts. Trees and graphs keep no particular order.
+/// last edge ends where the first starts. Trees and graphs keep their edges in the
+/// elimination order of their [`GraphLayout`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Island {
     /// Its shape.
@@ -60,6 +62,8 @@ pub struct Island {
     /// Whether two of its edges join the same two particles (a redundant constraint:
     /// the system is singular and no solver accepts it).
     pub duplicate_edge: bool,
+    /// The layout of a tree or graph (index into [`IslandSet::graphs`]).
+    pub graph: Option<usize>,
 }
 
 /// All islands of a topology.
@@ -69,6 +73,8 @@ pub struct IslandSet {
     pub islands: Vec<Island>,
     /// Their edges, island by island.
     pub edges: Vec<IslandEdge>,
+    /// The layouts of the tree and graph islands.
+    pub graphs: Vec<GraphLayout>,
 }
 
 /// Find and classify the islands of the dynamic edges.
@@ -136,6 +142,12 @@ pub fn find_islands(edges: &[Edge], pinned: &[bool]) -> IslandSet {
                 }
             })),
         }
+        let graph =
+            (matches!(kind, IslandKind::Tree | IslandKind::Graph) && !duplicate_edge).then(|| {
+                let layout = GraphLayout::new(&mut set.edges[start..], pinned);
+                set.graphs.push(layout);
+                set.graphs.len() - 1
+            });
         for &k in group {
             let e = &edges[k as usize];
             degree[e.a as usize] = 0;
@@ -145,6 +157,7 @@ pub fn find_islands(edges: &[Edge], pinned: &[bool]) -> IslandSet {
             kind,
             edges: start..set.edges.len(),
             duplicate_edge,
+            graph,
         });
     }
     set

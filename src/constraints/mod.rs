@@ -7,8 +7,10 @@
 //! [`projection`]); the systems here are thin adapters.
 
 pub mod cyclic;
+pub mod graph;
 pub mod islands;
 pub mod projection;
+pub mod sparse;
 pub mod tridiagonal;
 
 use std::fmt;
@@ -24,7 +26,8 @@ use crate::state::ParticleState;
 use crate::topology::{InputProblems, Topology, rebuild_topology};
 use islands::{IslandKind, IslandSet, find_islands};
 use projection::{
-    Bodies, Chain, ChainScratch, ConstraintDirection, ContactRow, ProjectionSettings, project_chain,
+    Bodies, Chain, ConstraintDirection, ContactRow, Graph, IslandScratch, IslandView,
+    ProjectionSettings, project_island,
 };
 
 /// How edges keep their length.
@@ -32,7 +35,8 @@ use projection::{
 pub enum SolverKind {
     /// No constraints: every edge is a stretch spring.
     Springs,
-    /// Exact projection, linear time: Thomas on paths, Sherman–Morrison on loops.
+    /// Exact projection: Thomas on paths and Sherman–Morrison on loops (linear time),
+    /// sparse LDLᵀ on trees and graphs.
     #[default]
     Tridiagonal,
 }
@@ -54,7 +58,7 @@ impl SolverKind {
         match self {
             SolverKind::Springs => "stretch springs only, no constraints",
             SolverKind::Tridiagonal => {
-                "exact fast projection; Thomas solve on paths, Sherman-Morrison on loops (default)"
+                "exact fast projection; Thomas solve on paths, Sherman-Morrison on loops, sparse LDLT on trees and graphs (default)"
             }
         }
     }
@@ -64,16 +68,16 @@ impl SolverKind {
         match (self, kind) {
             (SolverKind::Tridiagonal, IslandKind::Path) => Some("Thomas"),
             (SolverKind::Tridiagonal, IslandKind::Cycle) => Some("cyclic (Sherman-Morrison)"),
-            _ => None,
+            (SolverKind::Tridiagonal, IslandKind::Tree | IslandKind::Graph) => {
+                Some("sparse LDLT (minimum degree)")
+            }
+            (SolverKind::Springs, _) => None,
         }
     }
 
     /// Whether the solver can solve islands of `kind`.
     pub fn solves(self, kind: IslandKind) -> bool {
-        match self {
-            SolverKind::Springs => false,
-            SolverKind::Tridiagonal => matches!(kind, IslandKind::Path | IslandKind::Cycle),
-        }
+        self.method(kind).is_some()
     }
 }
 
@@ -165,7 +169,7 @@ pub struct Islands {
     island_of_particle: Vec<u32>,
     touched: Vec<(u32, u32)>,
     rows: Vec<ContactRow>,
-    scratch: ChainScratch,
+    scratch: IslandScratch,
 }
 
 impl Islands {
@@ -183,11 +187,18 @@ impl Islands {
             .map(|i| i as usize)
     }
 
-    fn chain(&self, island: usize) -> Chain<'_> {
+    fn view(&self, island: usize) -> IslandView<'_> {
         let island = &self.set.islands[island];
-        Chain {
-            edges: &self.set.edges[island.edges.clone()],
-            closed: island.kind == IslandKind::Cycle,
+        let edges = &self.set.edges[island.edges.clone()];
+        match island.graph {
+            Some(g) => IslandView::Graph(Graph {
+                edges,
+                layout: &self.set.graphs[g],
+            }),
+            None => IslandView::Chain(Chain {
+                edges,
+                closed: island.kind == IslandKind::Cycle,
+            }),
         }
     }
 
@@ -289,8 +300,8 @@ impl Islands {
             velocity: &mut *bodies.velocity,
             inverse_mass: bodies.inverse_mass,
         };
-        let outcome = project_chain(
-            self.chain(island),
+        let outcome = project_island(
+            self.view(island),
             bodies,
             contacts,
             dt,
@@ -344,14 +355,18 @@ pub fn rebuild_islands(
         edge.spring = !edge.is_static && edge.stiffness > 0.0;
     }
     let (mut solved, mut unsolved) = (Vec::new(), Vec::new());
-    let mut longest = 0;
+    let (mut longest, mut most_particles) = (0, 0);
     for (i, island) in set.islands.iter().enumerate() {
         if config.solver == SolverKind::Springs {
             continue;
         }
         if config.solver.solves(island.kind) && !island.duplicate_edge {
             solved.push(i);
+            let particles = island
+                .graph
+                .map_or(island.edges.len() + 1, |g| set.graphs[g].particles.len());
             longest = longest.max(island.edges.len());
+            most_particles = most_particles.max(particles);
             for e in &set.edges[island.edges.clone()] {
                 let edge = &mut topology.edges[e.edge as usize];
                 edge.constrained = true;
@@ -380,7 +395,7 @@ pub fn rebuild_islands(
             );
         }
     }
-    islands.scratch.reserve(longest);
+    islands.scratch.reserve(longest, most_particles);
     islands.island_of_particle.clear();
     islands
         .island_of_particle

@@ -1,5 +1,7 @@
-//! Fast projection of a chain island (a path or a loop) onto its length constraints,
-//! optionally subject to contacts that must not approach (DESIGN §5, §7).
+//! Fast projection of an island onto its length constraints, optionally subject to
+//! contacts that must not approach (DESIGN §5, §7). A path or a loop has a tridiagonal
+//! system (Thomas; Sherman–Morrison for the loop's corners); a tree or a general graph
+//! a sparse one, factored by [`super::sparse`] in the order its layout planned.
 //!
 //! Per edge k from a to b, `C_k(x) = |x_b − x_a|² − L_k²`. Starting from the
 //! unconstrained end of step `x̃ = x + dt v*`, repeat: solve `A δ = −C(x̃)` with
@@ -24,11 +26,11 @@
 //! **Contacts.** After collision impulses, an island is projected again with each of
 //! its contacts as an inequality row `Σ cᵢ n·vᵢ ≥ target` (a point against an edge:
 //! the point's velocity minus the edge's at the contact point, along the normal).
-//! Each Newton step eliminates the edge unknowns through the tridiagonal solve (one
+//! Each Newton step eliminates the edge unknowns through the island's factor (one
 //! solve per contact column), leaving a small contact-space complementarity problem,
 //! solved by projected Gauss–Seidel. The edge equations hold exactly for any contact
 //! impulses, so lengths are exact whatever the contacts do; the contacts are met to
-//! the complementarity tolerance. Particles outside the chain keep their velocities.
+//! the complementarity tolerance. Particles outside the island keep their velocities.
 //! With contacts the end-of-step direction is used, whatever the setting, since the
 //! elimination needs the symmetric system.
 //!
@@ -38,7 +40,9 @@ use bevy::math::DVec2;
 use bevy::prelude::Reflect;
 
 use super::cyclic::CyclicFactor;
+use super::graph::GraphLayout;
 use super::islands::IslandEdge;
+use super::sparse::SparseFactor;
 use super::tridiagonal::{SingularPivot, TridiagonalFactor, solve_tridiagonal};
 
 /// Where the constraint direction is evaluated (DESIGN §5).
@@ -63,7 +67,7 @@ pub struct ProjectionSettings {
     /// How far (a distance per step) a contact row may fall short of its target.
     pub contact_tolerance: f64,
     /// Reject the projection (change nothing) if it would move any particle by more
-    /// than this fraction of the chain's shortest rest length in one step; infinite
+    /// than this fraction of the island's shortest rest length in one step; infinite
     /// for no limit. Guards re-projections under contact, where nearly dependent
     /// constraints can ask for absurd corrections.
     pub max_correction: f64,
@@ -144,7 +148,7 @@ const POLISH_RESIDUAL: f64 = 1e-6;
 /// stage's verification.
 pub const MAX_CONTACT_ROWS: usize = 64;
 
-/// A contact row in chain-local terms.
+/// A contact row in island-local terms.
 #[derive(Clone, Copy, Debug, Default)]
 struct LocalRow {
     entries: [(u32, f64); 3],
@@ -154,9 +158,9 @@ struct LocalRow {
     slack: f64,
 }
 
-/// Reusable buffers for [`project_chain`], sized by [`ChainScratch::reserve`].
+/// Reusable buffers for [`project_island`], sized by [`IslandScratch::reserve`].
 #[derive(Clone, Debug, Default)]
-pub struct ChainScratch {
+pub struct IslandScratch {
     correction: Vec<DVec2>,
     inverse_mass: Vec<f64>,
     locked: Vec<bool>,
@@ -169,11 +173,11 @@ pub struct ChainScratch {
     upper: Vec<f64>,
     rhs: Vec<f64>,
     thomas: Vec<f64>,
-    open_factor: TridiagonalFactor,
-    cyclic_factor: CyclicFactor,
+    factors: Factors,
     local_of: Vec<u32>,
     rows: Vec<LocalRow>,
-    columns: Vec<SparseColumn>,
+    columns: Vec<std::ops::Range<u32>>,
+    column_entries: Vec<(u32, f64)>,
     solved_columns: Vec<f64>,
     schur: Vec<f64>,
     offset: Vec<f64>,
@@ -182,10 +186,10 @@ pub struct ChainScratch {
     row_particles: Vec<(u32, u32, f64)>,
 }
 
-impl ChainScratch {
-    /// Make room for chains of up to `edges` edges (allocates only when growing).
-    pub fn reserve(&mut self, edges: usize) {
-        let particles = edges + 1;
+impl IslandScratch {
+    /// Make room for islands of up to `edges` edges among `particles` particles
+    /// (allocates only when growing).
+    pub fn reserve(&mut self, edges: usize, particles: usize) {
         grow(&mut self.correction, particles, DVec2::ZERO);
         grow(&mut self.inverse_mass, particles, 0.0);
         grow(&mut self.locked, edges, false);
@@ -204,13 +208,13 @@ impl ChainScratch {
         }
     }
 
-    /// Make room for contact rows on chains of up to `edges` edges among `particles`
-    /// packed particles.
-    pub fn reserve_contacts(&mut self, edges: usize, particles: usize) {
+    /// Make room for contact rows on islands of up to `edges` edges, at most `degree`
+    /// of them at a particle, among `particles` packed particles.
+    pub fn reserve_contacts(&mut self, edges: usize, degree: usize, particles: usize) {
         grow(&mut self.local_of, particles, NOT_IN_CHAIN);
         let rows = MAX_CONTACT_ROWS;
         self.rows.reserve(rows.saturating_sub(self.rows.len()));
-        grow(&mut self.columns, rows, SparseColumn::default());
+        grow(&mut self.columns, rows, 0..0);
         grow(&mut self.solved_columns, rows * edges, 0.0);
         grow(&mut self.schur, rows * rows, 0.0);
         grow(&mut self.offset, rows, 0.0);
@@ -218,40 +222,13 @@ impl ChainScratch {
         grow(&mut self.contact_residual, rows, 0.0);
         self.row_particles
             .reserve((3 * rows).saturating_sub(self.row_particles.len()));
+        // Up to `degree` edges at each of a row's three particles.
+        self.column_entries
+            .reserve((3 * degree * rows).saturating_sub(self.column_entries.len()));
     }
 }
 
 const NOT_IN_CHAIN: u32 = u32::MAX;
-
-/// A column `J W N_cᵀ` of a contact row: at most two edges at each of its three
-/// particles are non-zero.
-#[derive(Clone, Copy, Debug, Default)]
-struct SparseColumn {
-    entries: [(u32, f64); 6],
-    count: usize,
-}
-
-impl SparseColumn {
-    fn add(&mut self, k: usize, value: f64) {
-        match self.entries[..self.count]
-            .iter_mut()
-            .find(|(i, _)| *i as usize == k)
-        {
-            Some(entry) => entry.1 += value,
-            None => {
-                self.entries[self.count] = (k as u32, value);
-                self.count += 1;
-            }
-        }
-    }
-
-    fn dot(&self, dense: &[f64]) -> f64 {
-        self.entries[..self.count]
-            .iter()
-            .map(|&(k, v)| v * dense[k as usize])
-            .sum()
-    }
-}
 
 fn grow<T: Clone>(buffer: &mut Vec<T>, n: usize, value: T) {
     if buffer.len() < n {
@@ -285,24 +262,244 @@ pub struct Chain<'a> {
     pub closed: bool,
 }
 
+/// A tree or graph island: its edges in the layout's order, and the layout.
+#[derive(Clone, Copy, Debug)]
+pub struct Graph<'a> {
+    /// The edges, in [`GraphLayout`] order.
+    pub edges: &'a [IslandEdge],
+    /// Local particles, incidence and the sparse plan.
+    pub layout: &'a GraphLayout,
+}
+
+/// Any island the projection solves.
+#[derive(Clone, Copy, Debug)]
+pub enum IslandView<'a> {
+    /// A path or a loop: a tridiagonal or cyclic tridiagonal system.
+    Chain(Chain<'a>),
+    /// A tree or graph: a sparse LDLᵀ.
+    Graph(Graph<'a>),
+}
+
+/// How the projection walks an island's particles and edges, and solves its system:
+/// a generic parameter, so that each kind's loops compile without a branch per edge.
+trait Walk: Copy {
+    /// Particles of the island of `edges`.
+    fn particles(self, edges: &[IslandEdge]) -> usize;
+    /// Packed index of local particle `j`.
+    fn particle(self, edges: &[IslandEdge], j: usize) -> usize;
+    /// Local ends of edge `k`.
+    fn ends(self, k: usize, particles: usize) -> (usize, usize);
+    /// The island edges at local particle `j`, with −1 where `j` starts the edge and +1
+    /// where it ends it.
+    fn for_incident(self, j: usize, m: usize, visit: impl FnMut(usize, f64));
+    /// The most island edges at one particle.
+    fn max_degree(self) -> usize;
+    /// Whether the system must be the symmetric (end-of-step) one.
+    fn symmetric_only(self) -> bool;
+    /// Assemble and factor the system at the current iterate, and solve it for
+    /// `s.rhs`; keep the factor for [`Walk::solve_many`] when `keep_factor`.
+    fn solve(
+        self,
+        m: usize,
+        direction: ConstraintDirection,
+        keep_factor: bool,
+        s: &mut IslandScratch,
+    ) -> Result<(), SingularPivot>;
+    /// Solve again with the kept factor, for `k` right-hand sides row by row.
+    fn solve_many(self, m: usize, factors: &Factors, columns: &mut [f64], k: usize);
+}
+
+/// A path or a loop.
+#[derive(Clone, Copy, Debug)]
+struct ChainWalk {
+    closed: bool,
+}
+
+impl Walk for ChainWalk {
+    fn particles(self, edges: &[IslandEdge]) -> usize {
+        edges.len() + usize::from(!self.closed)
+    }
+
+    #[inline]
+    fn particle(self, edges: &[IslandEdge], j: usize) -> usize {
+        (if j < edges.len() {
+            edges[j].a
+        } else {
+            edges[j - 1].b
+        }) as usize
+    }
+
+    #[inline]
+    fn ends(self, k: usize, particles: usize) -> (usize, usize) {
+        (k, if k + 1 == particles { 0 } else { k + 1 })
+    }
+
+    fn for_incident(self, j: usize, m: usize, mut visit: impl FnMut(usize, f64)) {
+        if j < m {
+            visit(j, -1.0);
+        }
+        if j > 0 {
+            visit(j - 1, 1.0);
+        } else if self.closed {
+            visit(m - 1, 1.0);
+        }
+    }
+
+    fn max_degree(self) -> usize {
+        2
+    }
+
+    fn symmetric_only(self) -> bool {
+        false
+    }
+
+    fn solve(
+        self,
+        m: usize,
+        direction: ConstraintDirection,
+        keep_factor: bool,
+        s: &mut IslandScratch,
+    ) -> Result<(), SingularPivot> {
+        chain_solve(m, self.closed, direction, keep_factor, s)
+    }
+
+    fn solve_many(self, m: usize, factors: &Factors, columns: &mut [f64], k: usize) {
+        if self.closed && m >= 3 {
+            factors.cyclic.solve_many(columns, k);
+        } else {
+            factors.open.solve_many(columns, k);
+        }
+    }
+}
+
+/// A tree or a graph.
+#[derive(Clone, Copy, Debug)]
+struct GraphWalk<'a> {
+    layout: &'a GraphLayout,
+}
+
+impl Walk for GraphWalk<'_> {
+    fn particles(self, _edges: &[IslandEdge]) -> usize {
+        self.layout.particles.len()
+    }
+
+    #[inline]
+    fn particle(self, _edges: &[IslandEdge], j: usize) -> usize {
+        self.layout.particles[j] as usize
+    }
+
+    #[inline]
+    fn ends(self, k: usize, _particles: usize) -> (usize, usize) {
+        let (a, b) = self.layout.ends[k];
+        (a as usize, b as usize)
+    }
+
+    fn for_incident(self, j: usize, _m: usize, mut visit: impl FnMut(usize, f64)) {
+        for &(k, sign) in self.layout.incident(j) {
+            visit(k as usize, sign);
+        }
+    }
+
+    fn max_degree(self) -> usize {
+        self.layout.max_degree()
+    }
+
+    fn symmetric_only(self) -> bool {
+        true
+    }
+
+    fn solve(
+        self,
+        m: usize,
+        _direction: ConstraintDirection,
+        _keep_factor: bool,
+        s: &mut IslandScratch,
+    ) -> Result<(), SingularPivot> {
+        graph_solve(m, self.layout, s)
+    }
+
+    fn solve_many(self, _m: usize, factors: &Factors, columns: &mut [f64], k: usize) {
+        factors.sparse.solve_many(&self.layout.plan, columns, k);
+    }
+}
+
+/// The factors an island's system may be kept in between solves.
+#[derive(Clone, Debug, Default)]
+struct Factors {
+    open: TridiagonalFactor,
+    cyclic: CyclicFactor,
+    sparse: SparseFactor,
+}
+
 /// Project the velocities of one chain so that every edge ends the step at its rest
-/// length, and no contact row falls below its target. Only free particles of the chain
-/// change velocity. Returns how the iteration ended; on a singular system the
-/// corrections found so far are applied.
+/// length, and no contact row falls below its target; see [`project_island`].
 pub fn project_chain(
     chain: Chain,
     bodies: Bodies,
     contacts: &[ContactRow],
     dt: f64,
     settings: &ProjectionSettings,
-    scratch: &mut ChainScratch,
+    scratch: &mut IslandScratch,
+) -> ProjectionOutcome {
+    project_island(
+        IslandView::Chain(chain),
+        bodies,
+        contacts,
+        dt,
+        settings,
+        scratch,
+    )
+}
+
+/// Project the velocities of one island so that every edge ends the step at its rest
+/// length, and no contact row falls below its target. Only free particles of the
+/// island change velocity. Returns how the iteration ended; on a singular system the
+/// corrections found so far are applied. Trees and graphs always use the end-of-step
+/// direction: their sparse factorization needs the symmetric system.
+pub fn project_island(
+    island: IslandView,
+    bodies: Bodies,
+    contacts: &[ContactRow],
+    dt: f64,
+    settings: &ProjectionSettings,
+    scratch: &mut IslandScratch,
+) -> ProjectionOutcome {
+    match island {
+        IslandView::Chain(Chain { edges, closed }) => project_walk(
+            edges,
+            ChainWalk { closed },
+            bodies,
+            contacts,
+            dt,
+            settings,
+            scratch,
+        ),
+        IslandView::Graph(Graph { edges, layout }) => project_walk(
+            edges,
+            GraphWalk { layout },
+            bodies,
+            contacts,
+            dt,
+            settings,
+            scratch,
+        ),
+    }
+}
+
+fn project_walk<W: Walk>(
+    edges: &[IslandEdge],
+    walk: W,
+    bodies: Bodies,
+    contacts: &[ContactRow],
+    dt: f64,
+    settings: &ProjectionSettings,
+    scratch: &mut IslandScratch,
 ) -> ProjectionOutcome {
     let Bodies {
         position,
         velocity,
         inverse_mass,
     } = bodies;
-    let Chain { edges, closed } = chain;
     let m = edges.len();
     if m == 0 {
         return ProjectionOutcome {
@@ -310,10 +507,9 @@ pub fn project_chain(
             ..Default::default()
         };
     }
-    scratch.reserve(m);
-    let particles = if closed { m } else { m + 1 };
-    let particle = |j: usize| if j < m { edges[j].a } else { edges[m - 1].b } as usize;
-    let next = |k: usize| if k + 1 == particles { 0 } else { k + 1 };
+    let particles = walk.particles(edges);
+    scratch.reserve(m, particles);
+    let particle = |j: usize| walk.particle(edges, j);
     let shortest = edges
         .iter()
         .map(|e| e.rest_length)
@@ -330,11 +526,15 @@ pub fn project_chain(
         let (a, b) = (e.a as usize, e.b as usize);
         scratch.start_direction[k] = position[b] - position[a];
         scratch.predicted_edge[k] = scratch.start_direction[k] + dt * (velocity[b] - velocity[a]);
-        let w = scratch.inverse_mass[k] + scratch.inverse_mass[next(k)];
+        let (ja, jb) = walk.ends(k, particles);
+        let w = scratch.inverse_mass[ja] + scratch.inverse_mass[jb];
         scratch.locked[k] = scratch.predicted_edge[k].length_squared() * w <= 0.0;
     }
-    localize_contacts(contacts, edges, particles, &particle, velocity, dt, scratch);
-    let direction = if scratch.rows.is_empty() {
+    if !contacts.is_empty() {
+        scratch.reserve_contacts(m, walk.max_degree(), velocity.len());
+    }
+    localize_contacts(contacts, particles, &particle, velocity, dt, scratch);
+    let direction = if scratch.rows.is_empty() && !walk.symmetric_only() {
         settings.direction
     } else {
         ConstraintDirection::EndOfStep
@@ -350,7 +550,8 @@ pub fn project_chain(
         let s = &mut *scratch;
         let mut residual = 0.0f64;
         for (k, e) in edges.iter().enumerate() {
-            s.edge[k] = s.predicted_edge[k] + (s.correction[next(k)] - s.correction[k]);
+            let (a, b) = walk.ends(k, particles);
+            s.edge[k] = s.predicted_edge[k] + (s.correction[b] - s.correction[a]);
             let rest_squared = e.rest_length * e.rest_length;
             s.constraint[k] = s.edge[k].length_squared() - rest_squared;
             if !s.locked[k] {
@@ -380,7 +581,7 @@ pub fn project_chain(
             break;
         }
         outcome.iterations += 1;
-        if newton_step(edges, closed, direction, contact_tolerance, s).is_err() {
+        if newton_step(m, particles, walk, direction, contact_tolerance, s).is_err() {
             outcome.singular = true;
             break;
         }
@@ -406,22 +607,20 @@ pub fn project_chain(
     outcome
 }
 
-/// Translate the contact rows touching the chain into local rows (up to
+/// Translate the contact rows touching the island into local rows (up to
 /// [`MAX_CONTACT_ROWS`]), with their current slack.
 fn localize_contacts(
     contacts: &[ContactRow],
-    edges: &[IslandEdge],
     particles: usize,
     particle: &impl Fn(usize) -> usize,
     velocity: &[DVec2],
     dt: f64,
-    scratch: &mut ChainScratch,
+    scratch: &mut IslandScratch,
 ) {
     scratch.rows.clear();
     if contacts.is_empty() {
         return;
     }
-    scratch.reserve_contacts(edges.len(), velocity.len());
     for j in 0..particles {
         scratch.local_of[particle(j)] = j as u32;
     }
@@ -473,116 +672,62 @@ fn row_change(row: &LocalRow, correction: &[DVec2]) -> f64 {
 }
 
 /// One Newton step on the edges (and contact rows) from the current corrections.
-fn newton_step(
-    edges: &[IslandEdge],
-    closed: bool,
+fn newton_step<W: Walk>(
+    m: usize,
+    particles: usize,
+    walk: W,
     direction_kind: ConstraintDirection,
     contact_tolerance: f64,
-    s: &mut ChainScratch,
+    s: &mut IslandScratch,
 ) -> Result<(), SingularPivot> {
-    let m = edges.len();
-    let particles = if closed { m } else { m + 1 };
-    let next = |k: usize| if k + 1 == particles { 0 } else { k + 1 };
-    let w = &s.inverse_mass;
-    let direction: &[DVec2] = match direction_kind {
-        ConstraintDirection::EndOfStep => &s.edge[..m],
-        ConstraintDirection::StartOfStep => &s.start_direction[..m],
-    };
-    for k in 0..m {
-        let prev_edge = if k == 0 { m - 1 } else { k - 1 };
-        let next_edge = if k + 1 == m { 0 } else { k + 1 };
-        let e = s.edge[k];
-        s.diagonal[k] = 4.0 * (w[k] + w[next(k)]) * e.dot(direction[k]);
-        s.lower[k] = -4.0 * w[k] * e.dot(direction[prev_edge]);
-        s.upper[k] = -4.0 * w[next(k)] * e.dot(direction[next_edge]);
-        s.rhs[k] = -s.constraint[k];
-    }
-    // A locked edge gets δ = 0: an identity row, and no coupling into its neighbours.
-    for k in (0..m).filter(|&k| s.locked[k]) {
-        s.diagonal[k] = 1.0;
-        (s.lower[k], s.upper[k], s.rhs[k]) = (0.0, 0.0, 0.0);
-        if k + 1 < m || closed {
-            s.lower[if k + 1 == m { 0 } else { k + 1 }] = 0.0;
-        }
-        if k > 0 || closed {
-            s.upper[if k == 0 { m - 1 } else { k - 1 }] = 0.0;
-        }
-    }
-    if !closed {
-        // An open chain's first and last rows have no outer neighbours.
-        s.lower[0] = 0.0;
-        s.upper[m - 1] = 0.0;
-    }
     let rows = s.rows.len();
-    let cyclic = closed && m >= 3;
-    if rows == 0 && !cyclic {
-        // One right-hand side: the fused single-pass Thomas solve is fastest.
-        solve_tridiagonal(
-            &s.lower[..m],
-            &s.diagonal[..m],
-            &s.upper[..m],
-            &mut s.rhs[..m],
-            &mut s.thomas[..m],
-        )?;
-    } else if cyclic {
-        s.cyclic_factor
-            .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
-        s.cyclic_factor.solve(&mut s.rhs[..m]);
-    } else {
-        s.open_factor
-            .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
-        s.open_factor.solve(&mut s.rhs[..m]);
+    for k in 0..m {
+        s.rhs[k] = if s.locked[k] { 0.0 } else { -s.constraint[k] };
     }
-    // Further right-hand sides reuse the factorization.
-    let (open_factor, cyclic_factor) = (&s.open_factor, &s.cyclic_factor);
-    let solve = |columns: &mut [f64], k: usize| {
-        if cyclic {
-            cyclic_factor.solve_many(columns, k);
-        } else {
-            open_factor.solve_many(columns, k);
-        }
-    };
+    walk.solve(m, direction_kind, rows > 0, s)?;
 
     if rows > 0 {
         // Columns b_c = J W N_cᵀ, then Y = A⁻¹ B, all columns at once (row-major).
         let solved = &mut s.solved_columns[..m * rows];
         solved.fill(0.0);
+        s.column_entries.clear();
         for c in 0..rows {
             let row = s.rows[c];
-            let mut column = SparseColumn::default();
+            let start = s.column_entries.len();
             for &(j, coefficient) in &row.entries[..row.count] {
                 let j = j as usize;
-                let pushed = w[j] * coefficient * row.normal;
-                // Edge j starts at particle j; edge j − 1 ends there.
-                if j < m && !s.locked[j] {
-                    column.add(j, -2.0 * s.edge[j].dot(pushed));
-                }
-                let ending = if j > 0 {
-                    Some(j - 1)
-                } else if closed {
-                    Some(m - 1)
-                } else {
-                    None
-                };
-                if let Some(k) = ending.filter(|&k| !s.locked[k]) {
-                    column.add(k, 2.0 * s.edge[k].dot(pushed));
-                }
+                let pushed = s.inverse_mass[j] * coefficient * row.normal;
+                let (edge, locked, entries) = (&s.edge, &s.locked, &mut s.column_entries);
+                walk.for_incident(j, m, |k, sign| {
+                    if locked[k] {
+                        return;
+                    }
+                    let value = sign * 2.0 * edge[k].dot(pushed);
+                    match entries[start..].iter_mut().find(|(i, _)| *i as usize == k) {
+                        Some(entry) => entry.1 += value,
+                        None => entries.push((k as u32, value)),
+                    }
+                });
             }
-            for &(k, value) in &column.entries[..column.count] {
+            for &(k, value) in &s.column_entries[start..] {
                 solved[k as usize * rows + c] = value;
             }
-            s.columns[c] = column;
+            s.columns[c] = start as u32..s.column_entries.len() as u32;
         }
-        solve(solved, rows);
+        walk.solve_many(m, &s.factors, solved, rows);
         // The contact-space system S μ + q ≥ 0, μ ≥ 0, complementary:
         // S = N W Nᵀ − Bᵀ A⁻¹ B, q = slack + Bᵀ λ.
         for c in 0..rows {
-            let column = s.columns[c];
-            s.offset[c] =
-                s.rows[c].slack + row_change(&s.rows[c], &s.correction) + column.dot(&s.rhs[..m]);
+            let column = &s.column_entries[s.columns[c].start as usize..s.columns[c].end as usize];
+            s.offset[c] = s.rows[c].slack
+                + row_change(&s.rows[c], &s.correction)
+                + column
+                    .iter()
+                    .map(|&(k, v)| v * s.rhs[k as usize])
+                    .sum::<f64>();
             let schur_row = &mut s.schur[c * rows..(c + 1) * rows];
             schur_row.fill(0.0);
-            for &(k, v) in &column.entries[..column.count] {
+            for &(k, v) in column {
                 let solved_row = &solved[k as usize * rows..(k as usize + 1) * rows];
                 for (entry, y) in schur_row.iter_mut().zip(solved_row) {
                     *entry -= v * y;
@@ -590,21 +735,15 @@ fn newton_step(
             }
         }
         // N W Nᵀ: only rows that share a particle meet.
-        let mut start = 0;
-        while start < s.row_particles.len() {
-            let j = s.row_particles[start].0;
-            let end = start
-                + s.row_particles[start..]
-                    .iter()
-                    .take_while(|e| e.0 == j)
-                    .count();
-            for &(_, c, cc) in &s.row_particles[start..end] {
-                for &(_, d, cd) in &s.row_particles[start..end] {
+        let w = &s.inverse_mass;
+        for group in s.row_particles.chunk_by(|x, y| x.0 == y.0) {
+            let j = group[0].0 as usize;
+            for &(_, c, cc) in group {
+                for &(_, d, cd) in group {
                     let normals = s.rows[c as usize].normal.dot(s.rows[d as usize].normal);
-                    s.schur[c as usize * rows + d as usize] += cc * cd * w[j as usize] * normals;
+                    s.schur[c as usize * rows + d as usize] += cc * cd * w[j] * normals;
                 }
             }
-            start = end;
         }
         projected_gauss_seidel(
             &s.schur[..rows * rows],
@@ -626,8 +765,8 @@ fn newton_step(
     };
     for (k, d) in direction.iter().enumerate() {
         let impulse = 2.0 * s.rhs[k] * *d;
-        let b = next(k);
-        s.correction[k] -= s.inverse_mass[k] * impulse;
+        let (a, b) = walk.ends(k, particles);
+        s.correction[a] -= s.inverse_mass[a] * impulse;
         s.correction[b] += s.inverse_mass[b] * impulse;
     }
     for c in 0..rows {
@@ -636,6 +775,94 @@ fn newton_step(
             s.correction[j as usize] += s.inverse_mass[j as usize] * coefficient * mu * row.normal;
         }
     }
+    Ok(())
+}
+
+/// Assemble the tridiagonal (or cyclic) system of a chain and solve it for the
+/// right-hand side in `s.rhs`, keeping the factor when contact columns will follow.
+fn chain_solve(
+    m: usize,
+    closed: bool,
+    direction_kind: ConstraintDirection,
+    keep_factor: bool,
+    s: &mut IslandScratch,
+) -> Result<(), SingularPivot> {
+    let particles = if closed { m } else { m + 1 };
+    let next = |k: usize| if k + 1 == particles { 0 } else { k + 1 };
+    let w = &s.inverse_mass;
+    let direction: &[DVec2] = match direction_kind {
+        ConstraintDirection::EndOfStep => &s.edge[..m],
+        ConstraintDirection::StartOfStep => &s.start_direction[..m],
+    };
+    for k in 0..m {
+        let prev_edge = if k == 0 { m - 1 } else { k - 1 };
+        let next_edge = if k + 1 == m { 0 } else { k + 1 };
+        let e = s.edge[k];
+        s.diagonal[k] = 4.0 * (w[k] + w[next(k)]) * e.dot(direction[k]);
+        s.lower[k] = -4.0 * w[k] * e.dot(direction[prev_edge]);
+        s.upper[k] = -4.0 * w[next(k)] * e.dot(direction[next_edge]);
+    }
+    // A locked edge gets δ = 0: an identity row, and no coupling into its neighbours.
+    for k in (0..m).filter(|&k| s.locked[k]) {
+        s.diagonal[k] = 1.0;
+        (s.lower[k], s.upper[k]) = (0.0, 0.0);
+        if k + 1 < m || closed {
+            s.lower[if k + 1 == m { 0 } else { k + 1 }] = 0.0;
+        }
+        if k > 0 || closed {
+            s.upper[if k == 0 { m - 1 } else { k - 1 }] = 0.0;
+        }
+    }
+    if !closed {
+        // An open chain's first and last rows have no outer neighbours.
+        s.lower[0] = 0.0;
+        s.upper[m - 1] = 0.0;
+    }
+    if closed && m >= 3 {
+        s.factors
+            .cyclic
+            .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
+        s.factors.cyclic.solve(&mut s.rhs[..m]);
+    } else if keep_factor {
+        s.factors
+            .open
+            .factor(&s.lower[..m], &s.diagonal[..m], &s.upper[..m])?;
+        s.factors.open.solve(&mut s.rhs[..m]);
+    } else {
+        // One right-hand side: the fused single-pass Thomas solve is fastest.
+        solve_tridiagonal(
+            &s.lower[..m],
+            &s.diagonal[..m],
+            &s.upper[..m],
+            &mut s.rhs[..m],
+            &mut s.thomas[..m],
+        )?;
+    }
+    Ok(())
+}
+
+/// Assemble `J W Jᵀ` of a tree or graph (end-of-step direction) into its sparse factor,
+/// factor it and solve for the right-hand side in `s.rhs`.
+fn graph_solve(m: usize, layout: &GraphLayout, s: &mut IslandScratch) -> Result<(), SingularPivot> {
+    let w = &s.inverse_mass;
+    let values = s.factors.sparse.values_mut(&layout.plan);
+    let edges = layout.ends.iter().zip(&s.edge[..m]).zip(&s.locked[..m]);
+    for (value, ((&(a, b), e), &locked)) in values.iter_mut().zip(edges) {
+        *value = if locked {
+            1.0
+        } else {
+            4.0 * (w[a as usize] + w[b as usize]) * e.length_squared()
+        };
+    }
+    for c in &layout.couplings {
+        let (k, l) = (c.k as usize, c.l as usize);
+        if !s.locked[k] && !s.locked[l] {
+            values[c.value as usize] +=
+                4.0 * w[c.particle as usize] * c.sign * s.edge[k].dot(s.edge[l]);
+        }
+    }
+    s.factors.sparse.factor(&layout.plan)?;
+    s.factors.sparse.solve(&layout.plan, &mut s.rhs[..m]);
     Ok(())
 }
 
@@ -739,7 +966,7 @@ mod tests {
                 self.contacts,
                 self.dt,
                 &settings(direction),
-                &mut ChainScratch::default(),
+                &mut IslandScratch::default(),
             )
         }
 
@@ -837,6 +1064,175 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Random points with a random spanning tree, plus `extra` random cross-links.
+    fn random_graph(n: usize, extra: usize, rng: &mut StdRng) -> (Vec<DVec2>, Vec<IslandEdge>) {
+        let points: Vec<DVec2> = (0..n)
+            .map(|_| DVec2::new(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
+            .collect();
+        let mut pairs: Vec<(u32, u32)> = (1..n)
+            .map(|i| (rng.random_range(0..i) as u32, i as u32))
+            .collect();
+        while pairs.len() < n - 1 + extra {
+            let (a, b) = (rng.random_range(0..n) as u32, rng.random_range(0..n) as u32);
+            if a != b && !pairs.contains(&(a, b)) && !pairs.contains(&(b, a)) {
+                pairs.push((a, b));
+            }
+        }
+        let edges = pairs
+            .iter()
+            .enumerate()
+            .map(|(k, &(a, b))| IslandEdge {
+                a,
+                b,
+                rest_length: points[a as usize].distance(points[b as usize]),
+                edge: k as u32,
+            })
+            .collect();
+        (points, edges)
+    }
+
+    fn project_graph(
+        edges: &[IslandEdge],
+        layout: &GraphLayout,
+        position: &[DVec2],
+        velocity: &mut [DVec2],
+        inverse_mass: &[f64],
+        scratch: &mut IslandScratch,
+    ) -> ProjectionOutcome {
+        project_island(
+            IslandView::Graph(Graph { edges, layout }),
+            Bodies {
+                position,
+                velocity,
+                inverse_mass,
+            },
+            &[],
+            1.0 / 3000.0,
+            &settings(ConstraintDirection::EndOfStep),
+            scratch,
+        )
+    }
+
+    #[test]
+    fn random_trees_and_graphs_end_the_step_at_rest_length() {
+        let mut rng = StdRng::seed_from_u64(4);
+        for trial in 0..40 {
+            let n = rng.random_range(2..60);
+            // Trees, then graphs with a few loops (2n − 3 edges at most stay independent).
+            let extra = if trial % 2 == 0 {
+                0
+            } else {
+                rng.random_range(1..n.max(2))
+            };
+            let (points, mut edges) = random_graph(n, extra.min(n.saturating_sub(2)), &mut rng);
+            let mut pinned = vec![false; n];
+            let mut inverse_mass: Vec<f64> =
+                (0..n).map(|_| 1.0 / rng.random_range(0.1..10.0)).collect();
+            if trial % 3 == 1 {
+                pinned[0] = true;
+                inverse_mass[0] = 0.0;
+            }
+            let layout = GraphLayout::new(&mut edges, &pinned);
+            let velocity: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let v = DVec2::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    if pinned[i] { DVec2::ZERO } else { 3.0 * v }
+                })
+                .collect();
+            let mut v = velocity.clone();
+            let mut scratch = IslandScratch::default();
+            let outcome = project_graph(
+                &edges,
+                &layout,
+                &points,
+                &mut v,
+                &inverse_mass,
+                &mut scratch,
+            );
+            assert!(outcome.converged, "trial {trial}: {outcome:?}");
+            // Trees converge as fast as chains; random cross-links can make a graph
+            // nearly rigid, and Newton slower, but within the default cap.
+            let cap = if extra == 0 { 6 } else { 20 };
+            assert!(outcome.iterations <= cap, "trial {trial}: {outcome:?}");
+            let case = Case {
+                edges: &edges,
+                closed: false,
+                position: &points,
+                inverse_mass: &inverse_mass,
+                contacts: &[],
+                dt: 1.0 / 3000.0,
+            };
+            let error = case.max_relative_error(&v);
+            assert!(error < 1e-12, "trial {trial}: {error:e}");
+            if !pinned[0] {
+                let momentum =
+                    |v: &[DVec2]| -> DVec2 { (0..n).map(|i| v[i] / inverse_mass[i]).sum() };
+                let (after, before) = (momentum(&v), momentum(&velocity));
+                assert!(
+                    (after - before).length() < 1e-12 * before.length().max(1.0),
+                    "trial {trial}: momentum {after} vs {before}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_redundant_constraint_is_dropped_and_the_rest_met() {
+        // A wheel: a square, its centre and four spokes. Five particles keep seven
+        // distances independent in 2D; the eighth follows from them.
+        let points = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(0.1, 0.0),
+            DVec2::new(0.1, 0.1),
+            DVec2::new(0.0, 0.1),
+            DVec2::new(0.05, 0.05),
+        ];
+        let mut edges: Vec<IslandEdge> = [
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 0),
+            (0, 4),
+            (1, 4),
+            (2, 4),
+            (3, 4),
+        ]
+        .iter()
+        .enumerate()
+        .map(|(k, &(a, b))| IslandEdge {
+            a,
+            b,
+            rest_length: points[a as usize].distance(points[b as usize]),
+            edge: k as u32,
+        })
+        .collect();
+        let layout = GraphLayout::new(&mut edges, &[false; 5]);
+        // Spinning, and one corner kicked outwards.
+        let centre = points[4];
+        let mut velocity: Vec<DVec2> = points.iter().map(|&p| 30.0 * (p - centre).perp()).collect();
+        velocity[2] += DVec2::new(2.0, 1.0);
+        let mut scratch = IslandScratch::default();
+        let outcome = project_graph(
+            &edges,
+            &layout,
+            &points,
+            &mut velocity,
+            &[1.0; 5],
+            &mut scratch,
+        );
+        assert!(outcome.converged && !outcome.singular, "{outcome:?}");
+        assert!(scratch.factors.sparse.dropped >= 1);
+        let case = Case {
+            edges: &edges,
+            closed: false,
+            position: &points,
+            inverse_mass: &[1.0; 5],
+            contacts: &[],
+            dt: 1.0 / 3000.0,
+        };
+        assert!(case.max_relative_error(&velocity) < 1e-12);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
+use bevy_strands::scene::container_builder;
 
 /// A headless app on `MinimalPlugins`, ticked by hand, with no gravity-independent
 /// defaults changed.
@@ -55,4 +56,31 @@ pub fn strand_state(app: &App, strand: Entity) -> Vec<(DVec2, DVec2)> {
         .into_iter()
         .map(|p| (position(app, p), velocity(app, p)))
         .collect()
+}
+
+/// An app with crossing checks on.
+pub fn checked_app() -> App {
+    let mut app = app();
+    app.world_mut()
+        .resource_mut::<CollisionConfig>()
+        .check_crossings = true;
+    app.world_mut()
+        .resource_mut::<StrandMetrics>()
+        .edge_crossings = Some(0);
+    app
+}
+
+/// Step ends at which edges crossed, so far.
+pub fn crossings(app: &App) -> u64 {
+    app.world()
+        .resource::<StrandMetrics>()
+        .edge_crossings
+        .unwrap()
+}
+
+/// The unit box as a pinned closed loop.
+pub fn spawn_box(app: &mut App) {
+    container_builder(DVec2::ZERO, DVec2::ONE)
+        .spawn_in(app.world_mut())
+        .unwrap();
 }
