@@ -328,6 +328,11 @@ impl StrandBuilder {
     }
 
     /// Check the description and compute rest lengths and angles.
+    /// The particles' positions, in order.
+    pub fn points(&self) -> &[DVec2] {
+        &self.points
+    }
+
     pub fn validate(&self) -> Result<(Vec<f64>, Vec<f64>), StrandError> {
         let n = self.points.len();
         let (kind, min) = if self.closed {

@@ -43,8 +43,15 @@ fn allocations_during(f: impl FnOnce()) -> u64 {
 
 #[test]
 fn steady_state_steps_and_ticks_allocate_nothing() {
+    // Chains (Thomas) in long_strand; trees and graphs (sparse LDLᵀ) in branches.
+    for scenario in ["long_strand", "branches"] {
+        steady_state_allocates_nothing(scenario);
+    }
+}
+
+fn steady_state_allocates_nothing(scenario: &str) {
     let scene = load_scene(&RunOptions {
-        scenario: "long_strand".into(),
+        scenario: scenario.into(),
         ..Default::default()
     })
     .unwrap();
@@ -65,11 +72,11 @@ fn steady_state_steps_and_ticks_allocate_nothing() {
             world.run_schedule(StrandsStep);
         }
     });
-    assert_eq!(steps, 0, "allocations in 300 steps");
+    assert_eq!(steps, 0, "{scenario}: allocations in 300 steps");
     let ticks = allocations_during(|| {
         for _ in 0..10 {
             world.run_schedule(StrandsTick);
         }
     });
-    assert_eq!(ticks, 0, "allocations in 10 ticks of 30 steps");
+    assert_eq!(ticks, 0, "{scenario}: allocations in 10 ticks of 30 steps");
 }

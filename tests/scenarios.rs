@@ -41,6 +41,38 @@ fn long_strand_runs_with_its_counts() {
 }
 
 #[test]
+fn branches_solves_its_trees_and_graphs_exactly() {
+    // One second: the ladder is thrown into the trees and falls back on the truss.
+    let report = run_ok(&options("branches", 1.0));
+    // The box; three trees of 14 + 6 + 5 particles joined by two links each; the
+    // ladder's two rails of 10 and four rungs; the truss' two chords of 6 and eleven
+    // braces. Every link is a strand of one edge.
+    assert_eq!(
+        (report.particles, report.strands, report.constrained_edges),
+        (
+            4 + 3 * 25 + 20 + 12,
+            1 + 3 * (3 + 2) + (2 + 4) + (2 + 11),
+            3 * (13 + 5 + 4 + 2) + (9 + 9 + 4) + (5 + 5 + 11)
+        )
+    );
+    assert_eq!(
+        (
+            report.islands.tree,
+            report.islands.graph,
+            report.islands.unsolved
+        ),
+        (3, 2, 0)
+    );
+    assert_eq!(report.edge_crossings, Some(0));
+    assert!(report.collisions > 0);
+    assert!(
+        report.max_rel_length_error < 1e-12,
+        "{:e}",
+        report.max_rel_length_error
+    );
+}
+
+#[test]
 fn spaghetti_factory_emits_on_schedule() {
     // Emissions at t = 0, 0.05, …, 0.65: fourteen particles, a finished strand of 13
     // and one particle of the next.
@@ -192,6 +224,7 @@ fn list_and_json_output() {
         "spaghetti_factory",
         "meatball_factory",
         "furry_creature",
+        "branches",
         "scale",
     ] {
         assert!(out.contains(name), "{out}");

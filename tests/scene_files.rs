@@ -100,6 +100,51 @@ fn coincident_consecutive_particles_are_rejected() {
 }
 
 #[test]
+fn links_must_name_two_existing_separate_particles_once() {
+    let with_links = |links: &str| {
+        GOOD.replace(
+            "particles: [(",
+            &format!("links: [{links}],\n    particles: [("),
+        )
+    };
+    let good = Scene::parse(&with_links("(from: (0, 9), to: (1, 0))"), "good.ron").unwrap();
+    assert_eq!(good.links.len(), 1);
+    let message = rejected(&with_links("(from: (0, 1), to: (2, 0))"));
+    assert!(
+        message.contains("links[0].to: strand 2 does not exist; the scene has 2 strands"),
+        "{message}"
+    );
+    let message = rejected(&with_links("(from: (0, 10), to: (1, 0))"));
+    assert!(
+        message.contains("links[0].from: strand 0 has no particle 10; it has 10"),
+        "{message}"
+    );
+    let message = rejected(&with_links("(from: (1, 2), to: (1, 2))"));
+    assert!(
+        message.contains("links[0]: an edge needs two different particles"),
+        "{message}"
+    );
+    // Particle 2 of strand 0 sits at (0.2, 0.5); a new strand puts its first there too.
+    let coincident = with_links("(from: (0, 2), to: (2, 0))").replace(
+        "mass: 2.0),",
+        "mass: 2.0),\n        (shape: Polyline(points: [(0.2, 0.5), (0.2, 0.6)])),",
+    );
+    let message = rejected(&coincident);
+    assert!(
+        message.contains("links[0]: its particles coincide")
+            && message.contains("zero rest length"),
+        "{message}"
+    );
+    let message = rejected(&with_links(
+        "(from: (0, 9), to: (1, 0)), (from: (1, 0), to: (0, 9))",
+    ));
+    assert!(
+        message.contains("links[1]: joins the same two particles as an earlier link"),
+        "{message}"
+    );
+}
+
+#[test]
 fn syntax_errors_and_unknown_fields_name_the_place() {
     let message = rejected(&GOOD.replace("substeps: 10", "substeps: 10, speed: 3"));
     assert!(message.contains("line 5"), "{message}");

@@ -73,6 +73,10 @@ pub struct Scene {
     /// Loose particles.
     #[serde(default)]
     pub particles: Vec<ParticleSpec>,
+    /// Edges joining particles of the strands above: branches (trees), rungs and
+    /// cross-links (graphs).
+    #[serde(default)]
+    pub links: Vec<LinkSpec>,
     /// A spaghetti factory.
     #[serde(default)]
     pub spaghetti_factory: Option<SpaghettiFactorySpec>,
@@ -380,6 +384,17 @@ pub struct StrandSpec {
     pub material: Option<MaterialSpec>,
 }
 
+/// An edge between two particles of `strands`, each named `(strand, particle)` by
+/// index; its rest length is their initial distance.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct LinkSpec {
+    /// One end: (strand index, particle index).
+    pub from: (usize, usize),
+    /// The other end.
+    pub to: (usize, usize),
+}
+
 /// A particle on its own.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -522,6 +537,7 @@ impl Scene {
                 .validate()
                 .map_err(|(field, p)| fail(&format!("{item}{field}"), p))?;
         }
+        self.validate_links().map_err(|(item, p)| fail(&item, p))?;
         if let Some(f) = &self.spaghetti_factory {
             let at = |field: &str| format!("spaghetti_factory.{field}");
             finite2(f.inlet).map_err(|p| fail(&at("inlet"), p))?;
@@ -627,6 +643,64 @@ impl MaterialSpec {
         ];
         for (name, value) in fields {
             non_negative(value).map_err(|p| (name, p))?;
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// Every link names two different, existing, separate particles, once.
+    fn validate_links(&self) -> Result<(), (String, String)> {
+        let points: Vec<Vec<DVec2>> = self
+            .strands
+            .iter()
+            .map(|s| s.builder().points().to_vec())
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        for (i, link) in self.links.iter().enumerate() {
+            let item = format!("links[{i}]");
+            let mut ends = [DVec2::ZERO; 2];
+            for (end, (field, (strand, particle))) in
+                ends.iter_mut().zip([("from", link.from), ("to", link.to)])
+            {
+                let Some(strand_points) = points.get(strand) else {
+                    return Err((
+                        format!("{item}.{field}"),
+                        format!(
+                            "strand {strand} does not exist; the scene has {} strands",
+                            points.len()
+                        ),
+                    ));
+                };
+                *end = *strand_points.get(particle).ok_or_else(|| {
+                    (
+                        format!("{item}.{field}"),
+                        format!(
+                            "strand {strand} has no particle {particle}; it has {}",
+                            strand_points.len()
+                        ),
+                    )
+                })?;
+            }
+            if link.from == link.to {
+                return Err((item, "an edge needs two different particles".into()));
+            }
+            if ends[0].distance(ends[1]) <= 0.0 {
+                return Err((
+                    item,
+                    format!(
+                        "its particles coincide at {:?}: a zero rest length",
+                        ends[0]
+                    ),
+                ));
+            }
+            let key = (link.from.min(link.to), link.from.max(link.to));
+            if !seen.insert(key) {
+                return Err((
+                    item,
+                    "joins the same two particles as an earlier link".into(),
+                ));
+            }
         }
         Ok(())
     }

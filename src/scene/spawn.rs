@@ -12,7 +12,8 @@ use crate::particle::{Mass, Particle, Pinned, Position, Velocity};
 use crate::scenes::furry_creature::{FurryCreature, spawn_furry_creature};
 use crate::scenes::meatball_factory::MeatballFactory;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
-use crate::strand::{StrandBuilder, StrandKind, StrandMaterial};
+use crate::strand::{Strand, StrandBuilder, StrandKind, StrandMaterial};
+use crate::tools::create_edge;
 
 /// Configure the world's resources from the scene and spawn its walls, strands and
 /// particles. The scene must have passed [`Scene::validate`].
@@ -75,11 +76,29 @@ pub fn spawn_scene(world: &mut World, scene: &Scene) -> Result<(), SceneError> {
             .spawn_in(world)
             .map_err(|e| fail("container".into(), e.to_string()))?;
     }
+    let mut strands = Vec::with_capacity(scene.strands.len());
     for (i, strand) in scene.strands.iter().enumerate() {
-        strand
+        let entity = strand
             .builder()
             .spawn_in(world)
             .map_err(|e| fail(format!("strands[{i}]"), e.to_string()))?;
+        strands.push(entity);
+    }
+    for (i, link) in scene.links.iter().enumerate() {
+        let particle = |(strand, particle): (usize, usize)| {
+            strands
+                .get(strand)
+                .and_then(|&s| world.get::<Strand>(s))
+                .and_then(|s| s.particles.get(particle).copied())
+                .ok_or_else(|| {
+                    fail(
+                        format!("links[{i}]"),
+                        format!("no particle {particle} in strand {strand}"),
+                    )
+                })
+        };
+        let (a, b) = (particle(link.from)?, particle(link.to)?);
+        create_edge(world, a, b).map_err(|e| fail(format!("links[{i}]"), e.to_string()))?;
     }
     if let Some(f) = &scene.spaghetti_factory {
         let mut factory = SpaghettiFactory::new(

@@ -81,6 +81,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/furry_creature.ron"),
     },
     BuiltinScene {
+        name: "branches",
+        file: "assets/scenes/branches.ron",
+        text: include_str!("../../assets/scenes/branches.ron"),
+    },
+    BuiltinScene {
         name: "scale",
         file: "assets/scenes/scale.ron",
         text: include_str!("../../assets/scenes/scale.ron"),
