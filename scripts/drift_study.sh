@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The constraint-drift study of docs/drift-study.md: long_strand's length errors with
 # stretch springs only, with constraints at one projection iteration per step, and
-# with constraints converged, each with and without stretch springs on top.
+# with constraints converged, each with and without stretch springs on top; and the
+# relaxation baselines (Gauss-Seidel, i.e. PBD, and Jacobi) at 20 and 100 sweeps.
 # Prints the study's table in Markdown.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,3 +25,7 @@ row "constraints, 1 iteration" --iterations 1
 row "constraints, 1 iteration + springs" --iterations 1 --stretch-springs
 row "constraints, converged" --solver tridiagonal
 row "constraints, converged + springs" --stretch-springs
+row "Gauss-Seidel relaxation (PBD), 20 sweeps" --solver gauss-seidel --iterations 20
+row "Gauss-Seidel relaxation (PBD), 100 sweeps" --solver gauss-seidel --iterations 100
+row "Jacobi relaxation, 20 sweeps" --solver jacobi --iterations 20
+row "Jacobi relaxation, 100 sweeps" --solver jacobi --iterations 100

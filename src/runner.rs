@@ -237,6 +237,13 @@ fn report(world: &World, scene: &Scene, wall_seconds: f64, particle_steps: u64) 
                 .to_string(),
         );
     }
+    if solver.relaxation().is_some() {
+        let sweeps = world.resource::<ConstraintConfig>().max_iterations;
+        notes.push(format!(
+            "solver {solver}: a relaxation baseline, {sweeps} sweeps per step at most; \
+             contacts are left to the collision impulses, not fed back into the solve"
+        ));
+    }
     if !world.resource::<CollisionConfig>().enabled {
         notes.push(
             "collisions are off in this run: edges may pass through each other, and \

@@ -393,3 +393,45 @@ fn switching_to_springs_releases_the_constraints() {
     // Springs stretch under the hanging weight.
     assert!(metrics.max_rel_length_error_now > 1e-4);
 }
+
+#[test]
+fn relaxation_baselines_take_every_island_and_land_between_springs_and_exact() {
+    // A hanging chain swinging, a tree and a loop, under each solver for half a second.
+    let run = |solver: SolverKind| {
+        let mut app = app();
+        app.world_mut().resource_mut::<ConstraintConfig>().solver = solver;
+        StrandBuilder::line(DVec2::new(0.2, 0.9), DVec2::X, 30, 0.02)
+            .pin_first()
+            .spawn_in(app.world_mut())
+            .unwrap();
+        let trunk = StrandBuilder::line(DVec2::new(0.3, 0.5), DVec2::X, 5, 0.05)
+            .spawn_in(app.world_mut())
+            .unwrap();
+        let fork = strand_particles(&app, trunk)[2];
+        let twig = app
+            .world_mut()
+            .spawn((Particle, Position(DVec2::new(0.4, 0.55))))
+            .id();
+        join(&mut app, fork, twig);
+        StrandBuilder::closed_loop([
+            DVec2::new(0.6, 0.5),
+            DVec2::new(0.68, 0.5),
+            DVec2::new(0.64, 0.57),
+        ])
+        .spawn_in(app.world_mut())
+        .unwrap();
+        ticks(&mut app, 50);
+        let islands = app.world().resource::<Islands>();
+        assert_eq!(islands.unsolved.len(), 0, "{solver}");
+        let metrics = app.world().resource::<StrandMetrics>();
+        (metrics.max_rel_length_error, metrics.projection.mean())
+    };
+    let (springs, _) = run(SolverKind::Springs);
+    let (exact, _) = run(SolverKind::Tridiagonal);
+    assert!(exact < 1e-12, "{exact:e}");
+    for solver in [SolverKind::GaussSeidel, SolverKind::Jacobi] {
+        let (error, sweeps) = run(solver);
+        assert!(exact < error && error < springs, "{solver}: {error:e}");
+        assert!(sweeps > 1.0, "{solver}: {sweeps}");
+    }
+}

@@ -210,7 +210,7 @@ fn bad_command_lines_are_refused_with_a_message() {
     assert!(!ok && err.contains("--fps 0"), "{err}");
     let (ok, _, err) = strands_command(&["run", "long_strand", "--solver", "magic"]);
     assert!(
-        !ok && err.contains("valid solvers: tridiagonal, springs"),
+        !ok && err.contains("valid solvers: tridiagonal, gauss-seidel, jacobi, springs"),
         "{err}"
     );
 }

@@ -50,8 +50,8 @@ struct RunArgs {
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
-    /// Cap on constraint-projection iterations per island per step (default: the
-    /// scene's, 20).
+    /// Cap on constraint-projection iterations (relaxation sweeps for the baselines) per
+    /// island per step (default: the scene's, 20).
     #[arg(long, value_name = "N")]
     iterations: Option<u32>,
     /// Keep stretch springs on constrained edges too (constraint-drift studies).

@@ -30,7 +30,7 @@ use bevy::prelude::*;
 
 use crate::config::StrandsConfig;
 use crate::constraints::projection::{Bodies, ContactRow, ProjectionSettings};
-use crate::constraints::{ConstraintConfig, Islands, SolverKind};
+use crate::constraints::{ConstraintConfig, Islands};
 use crate::metrics::StrandMetrics;
 use crate::schedule::{StepSet, StrandsStep};
 use crate::state::ParticleState;
@@ -491,7 +491,7 @@ pub fn collide(
         scratch,
     };
     let reprojection = match (constraint, islands) {
-        (Some(c), Some(i)) if c.solver != SolverKind::Springs && config.contact_passes > 0 => {
+        (Some(c), Some(i)) if c.solver.projects_contacts() && config.contact_passes > 0 => {
             Some((c, i))
         }
         _ => None,

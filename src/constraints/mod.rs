@@ -10,6 +10,7 @@ pub mod cyclic;
 pub mod graph;
 pub mod islands;
 pub mod projection;
+pub mod relaxation;
 pub mod sparse;
 pub mod tridiagonal;
 
@@ -29,6 +30,7 @@ use projection::{
     Bodies, Chain, ConstraintDirection, ContactRow, Graph, IslandScratch, IslandView,
     ProjectionSettings, project_island,
 };
+use relaxation::{Relaxation, RelaxationScratch, relax};
 
 /// How edges keep their length.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -39,17 +41,29 @@ pub enum SolverKind {
     /// sparse LDLᵀ on trees and graphs.
     #[default]
     Tridiagonal,
+    /// Baseline: Gauss–Seidel relaxation, one edge at a time (position-based dynamics;
+    /// zero-compliance XPBD), `max_iterations` sweeps.
+    GaussSeidel,
+    /// Baseline: Jacobi relaxation with per-particle averaging, `max_iterations` sweeps.
+    Jacobi,
 }
 
 impl SolverKind {
     /// Every solver, in the order `strands run --help` lists them.
-    pub const ALL: [SolverKind; 2] = [SolverKind::Tridiagonal, SolverKind::Springs];
+    pub const ALL: [SolverKind; 4] = [
+        SolverKind::Tridiagonal,
+        SolverKind::GaussSeidel,
+        SolverKind::Jacobi,
+        SolverKind::Springs,
+    ];
 
     /// The name used on the command line and in scene files and reports.
     pub fn name(self) -> &'static str {
         match self {
             SolverKind::Springs => "springs",
             SolverKind::Tridiagonal => "tridiagonal",
+            SolverKind::GaussSeidel => "gauss-seidel",
+            SolverKind::Jacobi => "jacobi",
         }
     }
 
@@ -59,6 +73,12 @@ impl SolverKind {
             SolverKind::Springs => "stretch springs only, no constraints",
             SolverKind::Tridiagonal => {
                 "exact fast projection; Thomas solve on paths, Sherman-Morrison on loops, sparse LDLT on trees and graphs (default)"
+            }
+            SolverKind::GaussSeidel => {
+                "baseline: Gauss-Seidel relaxation (PBD, zero-compliance XPBD), --iterations sweeps per step"
+            }
+            SolverKind::Jacobi => {
+                "baseline: Jacobi relaxation with averaging, --iterations sweeps per step"
             }
         }
     }
@@ -71,8 +91,26 @@ impl SolverKind {
             (SolverKind::Tridiagonal, IslandKind::Tree | IslandKind::Graph) => {
                 Some("sparse LDLT (minimum degree)")
             }
+            (SolverKind::GaussSeidel, _) => Some("Gauss-Seidel relaxation"),
+            (SolverKind::Jacobi, _) => Some("Jacobi relaxation"),
             (SolverKind::Springs, _) => None,
         }
+    }
+
+    /// The relaxation this baseline solver sweeps with, if it is one.
+    pub fn relaxation(self) -> Option<Relaxation> {
+        match self {
+            SolverKind::GaussSeidel => Some(Relaxation::GaussSeidel),
+            SolverKind::Jacobi => Some(Relaxation::Jacobi),
+            SolverKind::Springs | SolverKind::Tridiagonal => None,
+        }
+    }
+
+    /// Whether contacts are fed back into the constraint solve as inequality rows
+    /// (DESIGN §7). The baselines leave contacts to the collision impulses alone, as the
+    /// engines they stand for do.
+    pub fn projects_contacts(self) -> bool {
+        self == SolverKind::Tridiagonal
     }
 
     /// Whether the solver can solve islands of `kind`.
@@ -170,6 +208,7 @@ pub struct Islands {
     touched: Vec<(u32, u32)>,
     rows: Vec<ContactRow>,
     scratch: IslandScratch,
+    relaxation: RelaxationScratch,
 }
 
 impl Islands {
@@ -213,6 +252,28 @@ impl Islands {
         for slot in 0..self.solved.len() {
             let i = self.solved[slot];
             self.project_island(i, bodies, &[], dt, settings, stats);
+        }
+    }
+
+    /// Relax every solved island (the Constrain stage of the baseline solvers),
+    /// recording each solve.
+    pub fn relax(
+        &mut self,
+        method: Relaxation,
+        bodies: &mut Bodies,
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) {
+        for &i in &self.solved {
+            let bodies = Bodies {
+                position: bodies.position,
+                velocity: &mut *bodies.velocity,
+                inverse_mass: bodies.inverse_mass,
+            };
+            let edges = &self.set.edges[self.set.islands[i].edges.clone()];
+            let outcome = relax(edges, bodies, dt, method, settings, &mut self.relaxation);
+            stats.record(&outcome);
         }
     }
 
@@ -396,6 +457,7 @@ pub fn rebuild_islands(
         }
     }
     islands.scratch.reserve(longest, most_particles);
+    islands.relaxation.reserve(topology.pinned.len(), longest);
     islands.island_of_particle.clear();
     islands
         .island_of_particle
@@ -434,10 +496,15 @@ pub fn solve_constraints(
         velocity,
         inverse_mass,
     };
-    islands.project(
-        &mut bodies,
-        step.dt,
-        &config.projection(),
-        &mut metrics.projection,
-    );
+    let settings = config.projection();
+    match config.solver.relaxation() {
+        Some(method) => islands.relax(
+            method,
+            &mut bodies,
+            step.dt,
+            &settings,
+            &mut metrics.projection,
+        ),
+        None => islands.project(&mut bodies, step.dt, &settings, &mut metrics.projection),
+    }
 }
