@@ -10,11 +10,11 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
+use bevy_strands::constraints::ConstraintConfig;
 use bevy_strands::constraints::graph::GraphLayout;
 use bevy_strands::constraints::islands::IslandEdge;
 use bevy_strands::constraints::projection::{
-    Bodies, Chain, ConstraintDirection, Graph, IslandScratch, IslandView, ProjectionSettings,
-    project_chain, project_island,
+    Bodies, Chain, Graph, IslandScratch, IslandView, project_chain, project_island,
 };
 use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -108,13 +108,8 @@ fn constraint_stage(c: &mut Criterion) {
     let mut rng = StdRng::seed_from_u64(2);
     let (strands, particles) = (1000, 100);
     let pile = pile(strands, particles, &mut rng);
-    let settings = ProjectionSettings {
-        tolerance: 1e-12,
-        max_iterations: 20,
-        direction: ConstraintDirection::EndOfStep,
-        contact_tolerance: 0.0,
-        max_correction: f64::INFINITY,
-    };
+    // The plugin's defaults: tolerance 1e-12, at most 20 iterations, end-of-step.
+    let settings = ConstraintConfig::default().projection();
     let mut scratch = IslandScratch::default();
     scratch.reserve(particles, particles + 1);
     let dt = 1.0 / 3000.0;
@@ -161,16 +156,7 @@ struct Structure {
 
 impl Structure {
     fn new(position: Vec<DVec2>, pairs: &[(u32, u32)]) -> Structure {
-        let edges = pairs
-            .iter()
-            .enumerate()
-            .map(|(k, &(a, b))| IslandEdge {
-                a,
-                b,
-                rest_length: position[a as usize].distance(position[b as usize]),
-                edge: k as u32,
-            })
-            .collect();
+        let edges = IslandEdge::between(&position, pairs);
         Structure { position, edges }
     }
 }
@@ -214,13 +200,8 @@ fn structures() -> Vec<(&'static str, Structure)> {
 fn structure_projection(c: &mut Criterion) {
     let mut group = c.benchmark_group("projection_by_kind");
     let mut rng = StdRng::seed_from_u64(3);
-    let settings = ProjectionSettings {
-        tolerance: 1e-12,
-        max_iterations: 20,
-        direction: ConstraintDirection::EndOfStep,
-        contact_tolerance: 0.0,
-        max_correction: f64::INFINITY,
-    };
+    // The plugin's defaults: tolerance 1e-12, at most 20 iterations, end-of-step.
+    let settings = ConstraintConfig::default().projection();
     let dt = 1.0 / 3000.0;
     for (name, mut structure) in structures() {
         let n = structure.position.len();

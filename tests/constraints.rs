@@ -186,6 +186,18 @@ fn kick_randomly(app: &mut App, particles: &[Entity], speed: f64, rng: &mut StdR
     }
 }
 
+/// Exact away from contact, and through contact with the floor and the walls; and
+/// no crossing.
+fn assert_exact_through_contact(app: &App) {
+    let metrics = app.world().resource::<StrandMetrics>();
+    let (all, free) = (
+        metrics.max_rel_length_error,
+        metrics.max_rel_length_error_free,
+    );
+    assert!(free < 1e-12 && all < 1e-9, "{all:e}, {free:e}");
+    assert_eq!(crossings(app), 0);
+}
+
 #[test]
 fn trees_are_solved_by_the_sparse_solve() {
     let mut app = checked_app();
@@ -233,13 +245,7 @@ fn trees_are_solved_by_the_sparse_solve() {
     assert_eq!((islands.solved.len(), islands.unsolved.len()), (1, 0));
     let metrics = app.world().resource::<StrandMetrics>();
     assert_eq!(metrics.constrained_edges, 8 + 5 + 4);
-    // Exact away from contact, and through contact with the floor and the walls.
-    let (all, free) = (
-        metrics.max_rel_length_error,
-        metrics.max_rel_length_error_free,
-    );
-    assert!(free < 1e-12 && all < 1e-9, "{all:e}, {free:e}");
-    assert_eq!(crossings(&app), 0);
+    assert_exact_through_contact(&app);
 }
 
 #[test]
@@ -307,13 +313,7 @@ fn graphs_with_loops_and_a_redundant_brace_are_solved() {
     assert_eq!((islands.solved.len(), islands.unsolved.len()), (2, 0));
     let metrics = app.world().resource::<StrandMetrics>();
     assert_eq!(metrics.constrained_edges, 2 * 7 + 4 + 8);
-    // Exact away from contact, and through contact with the floor and the walls.
-    let (all, free) = (
-        metrics.max_rel_length_error,
-        metrics.max_rel_length_error_free,
-    );
-    assert!(free < 1e-12 && all < 1e-9, "{all:e}, {free:e}");
-    assert_eq!(crossings(&app), 0);
+    assert_exact_through_contact(&app);
 }
 
 #[test]

@@ -7,6 +7,8 @@
 
 use std::ops::Range;
 
+use bevy::math::DVec2;
+
 use super::graph::GraphLayout;
 use crate::topology::Edge;
 
@@ -46,6 +48,23 @@ pub struct IslandEdge {
     pub rest_length: f64,
     /// Index in [`Topology::edges`](crate::topology::Topology::edges).
     pub edge: u32,
+}
+
+impl IslandEdge {
+    /// Edges joining `pairs` of `points`, each at its current length, numbered in order
+    /// (for kernels used without a topology: tests, benchmarks, tools).
+    pub fn between(points: &[DVec2], pairs: &[(u32, u32)]) -> Vec<IslandEdge> {
+        pairs
+            .iter()
+            .enumerate()
+            .map(|(k, &(a, b))| IslandEdge {
+                a,
+                b,
+                rest_length: points[a as usize].distance(points[b as usize]),
+                edge: k as u32,
+            })
+            .collect()
+    }
 }
 
 /// One island: its kind and its edges in [`IslandSet::edges`].

@@ -1080,16 +1080,7 @@ mod tests {
                 pairs.push((a, b));
             }
         }
-        let edges = pairs
-            .iter()
-            .enumerate()
-            .map(|(k, &(a, b))| IslandEdge {
-                a,
-                b,
-                rest_length: points[a as usize].distance(points[b as usize]),
-                edge: k as u32,
-            })
-            .collect();
+        let edges = IslandEdge::between(&points, &pairs);
         (points, edges)
     }
 
@@ -1189,7 +1180,7 @@ mod tests {
             DVec2::new(0.0, 0.1),
             DVec2::new(0.05, 0.05),
         ];
-        let mut edges: Vec<IslandEdge> = [
+        let spokes = [
             (0, 1),
             (1, 2),
             (2, 3),
@@ -1198,16 +1189,8 @@ mod tests {
             (1, 4),
             (2, 4),
             (3, 4),
-        ]
-        .iter()
-        .enumerate()
-        .map(|(k, &(a, b))| IslandEdge {
-            a,
-            b,
-            rest_length: points[a as usize].distance(points[b as usize]),
-            edge: k as u32,
-        })
-        .collect();
+        ];
+        let mut edges = IslandEdge::between(&points, &spokes);
         let layout = GraphLayout::new(&mut edges, &[false; 5]);
         // Spinning, and one corner kicked outwards.
         let centre = points[4];
