@@ -41,6 +41,23 @@ fn long_strand_runs_with_its_counts() {
 }
 
 #[test]
+fn long_strand_stays_exact_through_contact_at_ten_times_the_step() {
+    // dt = 1/300: the strand lands moving a third of an edge per step, so the contact
+    // re-projection must take corrections of that size.
+    let report = run_ok(&RunOptions {
+        dt: Some(1.0 / 300.0),
+        substeps: Some(3),
+        ..options("long_strand", 3.0)
+    });
+    assert_eq!(report.edge_crossings, Some(0));
+    assert!(
+        report.max_rel_length_error < 1e-9,
+        "{:e}",
+        report.max_rel_length_error
+    );
+}
+
+#[test]
 fn branches_solves_its_trees_and_graphs_exactly() {
     // One second: the ladder is thrown into the trees and falls back on the truss.
     let report = run_ok(&options("branches", 1.0));

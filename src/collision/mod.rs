@@ -504,7 +504,11 @@ pub fn collide(
         // next step's proximity pass deals with it. Whatever happens, collisions come
         // last, so non-penetration is never traded for length.
         let settings = ProjectionSettings {
-            max_correction: 0.5,
+            // Two shortest edges per step: room for the corrections of a strand that
+            // lands moving a good part of an edge per step (dt = 1/300 on long_strand
+            // stays exact; half an edge rejected a sixth of those), while a nearly
+            // dependent set of rows asking for more is still refused.
+            max_correction: 2.0,
             // Contacts met to a thousandth of the thickness per step, well inside the
             // cushion (the edges are met exactly whatever the contacts do).
             contact_tolerance: 1e-3 * config.thickness,
