@@ -65,8 +65,9 @@ pub struct CollisionConfig {
     pub restitution: f64,
     /// Detection passes before the fail-safe.
     pub max_iterations: u32,
-    /// Alternations of constraint re-projection and collisions (DESIGN §7); 0 leaves
-    /// edges next to contacts as the impulses leave them.
+    /// Alternations of constraint re-projection and collisions (DESIGN §7), at most;
+    /// they stop as soon as a pass finds no new collision, so at small steps one or two
+    /// run whatever the cap. 0 leaves edges next to contacts as the impulses leave them.
     pub contact_passes: u32,
     /// How candidate pairs are found.
     pub broad_phase: BroadPhaseMethod,
@@ -82,7 +83,7 @@ impl Default for CollisionConfig {
             friction: 0.3,
             restitution: 0.0,
             max_iterations: 10,
-            contact_passes: 4,
+            contact_passes: 16,
             broad_phase: BroadPhaseMethod::Grid,
             check_crossings: false,
         }
@@ -309,8 +310,13 @@ impl Contacts<'_> {
         )?;
         let pair = self.pair(p, k, hit.alpha);
         let normal_velocity = hit.normal.dot(pair.relative_velocity(self.velocity));
-        // Touching while moving apart (or not at all) is no collision.
-        (normal_velocity < -self.negligible_speed()).then_some((pair, hit.normal, normal_velocity))
+        // Touching while moving apart (or not at all) is no collision; creeping through
+        // the edge, however slowly, is one.
+        let end = |x: usize| self.position[x] + dt * self.velocity[x];
+        let end_gap = hit.normal.dot(end(i) - end(a).lerp(end(b), hit.alpha));
+        let approaching = normal_velocity < -self.negligible_speed();
+        let creeping = normal_velocity < 0.0 && end_gap < 0.0;
+        (approaching || creeping).then_some((pair, hit.normal, normal_velocity))
     }
 
     /// Proximity, then crossings ([`Contacts::resolve_crossings`]).
