@@ -78,14 +78,16 @@ pub fn relax(
             s.count[e.b as usize] += 1;
         }
     }
+    let current = |s: &RelaxationScratch, k: usize, e: &IslandEdge| {
+        s.predicted_edge[k] + s.correction[e.b as usize] - s.correction[e.a as usize]
+    };
     let mut outcome = ProjectionOutcome::default();
     loop {
         let mut residual = 0.0f64;
         let mut locked = 0;
         for (k, e) in edges.iter().enumerate() {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let edge = s.predicted_edge[k] + s.correction[b] - s.correction[a];
-            if w[a] + w[b] <= 0.0 || edge.length_squared() == 0.0 {
+            let edge = current(s, k, e);
+            if w[e.a as usize] + w[e.b as usize] <= 0.0 || edge.length_squared() == 0.0 {
                 locked += 1;
                 continue;
             }
@@ -102,37 +104,26 @@ pub fn relax(
             break;
         }
         outcome.iterations += 1;
-        match method {
-            Relaxation::GaussSeidel => {
-                for (k, e) in edges.iter().enumerate() {
-                    let (a, b) = (e.a as usize, e.b as usize);
-                    let edge = s.predicted_edge[k] + s.correction[b] - s.correction[a];
-                    if let Some(step) = restoring_step(edge, e.rest_length, w[a] + w[b]) {
-                        s.correction[a] += w[a] * step;
-                        s.correction[b] -= w[b] * step;
-                    }
-                }
+        // Gauss–Seidel moves the corrections at once; Jacobi gathers the moves (its sums
+        // are zero between sweeps) and then averages them per particle.
+        for (k, e) in edges.iter().enumerate() {
+            let (a, b) = (e.a as usize, e.b as usize);
+            if let Some(step) = restoring_step(current(s, k, e), e.rest_length, w[a] + w[b]) {
+                let moved = match method {
+                    Relaxation::GaussSeidel => &mut s.correction,
+                    Relaxation::Jacobi => &mut s.sum,
+                };
+                moved[a] += w[a] * step;
+                moved[b] -= w[b] * step;
             }
-            Relaxation::Jacobi => {
-                for e in edges {
-                    s.sum[e.a as usize] = DVec2::ZERO;
-                    s.sum[e.b as usize] = DVec2::ZERO;
-                }
-                for (k, e) in edges.iter().enumerate() {
-                    let (a, b) = (e.a as usize, e.b as usize);
-                    let edge = s.predicted_edge[k] + s.correction[b] - s.correction[a];
-                    if let Some(step) = restoring_step(edge, e.rest_length, w[a] + w[b]) {
-                        s.sum[a] += w[a] * step;
-                        s.sum[b] -= w[b] * step;
-                    }
-                }
-                for e in edges {
-                    for p in [e.a as usize, e.b as usize] {
-                        if s.count[p] > 0 {
-                            s.correction[p] += s.sum[p] / s.count[p] as f64;
-                            // Applied once, however many edges meet here.
-                            s.sum[p] = DVec2::ZERO;
-                        }
+        }
+        if method == Relaxation::Jacobi {
+            for e in edges {
+                for p in [e.a as usize, e.b as usize] {
+                    if s.count[p] > 0 {
+                        s.correction[p] += s.sum[p] / s.count[p] as f64;
+                        // Applied once, however many edges meet here.
+                        s.sum[p] = DVec2::ZERO;
                     }
                 }
             }
