@@ -312,10 +312,11 @@ impl Contacts<'_> {
         let normal_velocity = hit.normal.dot(pair.relative_velocity(self.velocity));
         // Touching while moving apart (or not at all) is no collision; creeping through
         // the edge, however slowly, is one.
-        let end = |x: usize| self.position[x] + dt * self.velocity[x];
-        let end_gap = hit.normal.dot(end(i) - end(a).lerp(end(b), hit.alpha));
         let approaching = normal_velocity < -self.negligible_speed();
-        let creeping = normal_velocity < 0.0 && end_gap < 0.0;
+        let creeping = !approaching && normal_velocity < 0.0 && {
+            let end = |x: usize| self.position[x] + dt * self.velocity[x];
+            hit.normal.dot(end(i) - end(a).lerp(end(b), hit.alpha)) < 0.0
+        };
         (approaching || creeping).then_some((pair, hit.normal, normal_velocity))
     }
 

@@ -916,16 +916,10 @@ mod tests {
     use rand::{RngExt, SeedableRng};
 
     fn chain_edges(points: &[DVec2], closed: bool) -> Vec<IslandEdge> {
-        let n = points.len();
+        let n = points.len() as u32;
         let m = if closed { n } else { n - 1 };
-        (0..m)
-            .map(|k| IslandEdge {
-                a: k as u32,
-                b: ((k + 1) % n) as u32,
-                rest_length: points[k].distance(points[(k + 1) % n]),
-                edge: k as u32,
-            })
-            .collect()
+        let pairs: Vec<(u32, u32)> = (0..m).map(|k| (k, (k + 1) % n)).collect();
+        IslandEdge::between(points, &pairs)
     }
 
     fn settings(direction: ConstraintDirection) -> ProjectionSettings {
