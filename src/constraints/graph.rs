@@ -35,6 +35,8 @@ pub struct GraphLayout {
     incidence: Vec<(u32, f64)>,
     /// The off-diagonal entries of the system.
     pub couplings: Vec<Coupling>,
+    /// The most edges meeting at one particle.
+    pub max_degree: usize,
     /// The system's elimination order and fill.
     pub plan: SparsePlan,
 }
@@ -100,9 +102,15 @@ impl GraphLayout {
                 }
             }
         }
+        let max_degree = incidence_start
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as usize)
+            .max()
+            .unwrap_or(0);
         GraphLayout {
             particles,
             ends,
+            max_degree,
             incidence_start,
             incidence: incidence.into_iter().map(|(_, k, s)| (k, s)).collect(),
             couplings,
@@ -114,14 +122,5 @@ impl GraphLayout {
     /// where it is its end.
     pub fn incident(&self, j: usize) -> &[(u32, f64)] {
         &self.incidence[self.incidence_start[j] as usize..self.incidence_start[j + 1] as usize]
-    }
-
-    /// The most edges meeting at one particle.
-    pub fn max_degree(&self) -> usize {
-        self.incidence_start
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as usize)
-            .max()
-            .unwrap_or(0)
     }
 }

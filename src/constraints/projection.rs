@@ -401,7 +401,7 @@ impl Walk for GraphWalk<'_> {
     }
 
     fn max_degree(self) -> usize {
-        self.layout.max_degree()
+        self.layout.max_degree
     }
 
     fn symmetric_only(self) -> bool {
