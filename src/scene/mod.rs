@@ -651,6 +651,9 @@ impl MaterialSpec {
 impl Scene {
     /// Every link names two different, existing, separate particles, once.
     fn validate_links(&self) -> Result<(), (String, String)> {
+        if self.links.is_empty() {
+            return Ok(());
+        }
         let points: Vec<Vec<DVec2>> = self
             .strands
             .iter()
