@@ -15,9 +15,8 @@ use std::time::{Duration, Instant};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::broad_phase::BroadPhaseMethod;
-use bevy_strands::collision::collide;
 use bevy_strands::prelude::*;
-use bevy_strands::scene::container_builder;
+use bevy_strands_app::fixtures::{run_collide_stage, spawn_container};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 const PER_STRAND: usize = 100;
@@ -31,9 +30,11 @@ fn pile(particles: usize, method: BroadPhaseMethod) -> (App, Vec<DVec2>) {
     world.resource_mut::<StrandsConfig>().substeps = 1;
     let strands = particles / PER_STRAND;
     let gap = 0.9 * 0.004;
-    container_builder(DVec2::ZERO, DVec2::new(1.02, gap * (strands + 2) as f64))
-        .spawn_in(world)
-        .unwrap();
+    spawn_container(
+        world,
+        DVec2::ZERO,
+        DVec2::new(1.02, gap * (strands + 2) as f64),
+    );
     for s in 0..strands {
         let points = (0..PER_STRAND).map(|i| {
             let wave = 0.001 * ((i + s) as f64 * 0.7).sin();
@@ -77,7 +78,7 @@ fn collide_stage(c: &mut Criterion) {
                 .resource_mut::<ParticleState>()
                 .velocity
                 .copy_from_slice(&velocity);
-            world.run_system_cached(collide).unwrap();
+            run_collide_stage(world);
             let impulses = world.resource::<StrandMetrics>().collisions_last_step;
             eprintln!("{particles} particles, {method:?}: {impulses} impulses per stage");
             group.throughput(Throughput::Elements(particles as u64));
@@ -92,7 +93,7 @@ fn collide_stage(c: &mut Criterion) {
                             .velocity
                             .copy_from_slice(&velocity);
                         let start = Instant::now();
-                        world.run_system_cached(collide).unwrap();
+                        run_collide_stage(world);
                         black_box(&world.resource::<ParticleState>().velocity);
                         total += start.elapsed();
                     }

@@ -10,13 +10,13 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
-use bevy_strands::constraints::ConstraintConfig;
 use bevy_strands::constraints::graph::GraphLayout;
-use bevy_strands::constraints::islands::IslandEdge;
+use bevy_strands::constraints::island_edge::IslandEdge;
 use bevy_strands::constraints::projection::{
     Bodies, Chain, Graph, IslandScratch, IslandView, project_chain, project_island,
 };
 use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
+use bevy_strands::prelude::*;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -126,11 +126,7 @@ fn constraint_stage(c: &mut Criterion) {
                         edges: &pile.edges[range.clone()],
                         closed: false,
                     };
-                    let bodies = Bodies {
-                        position: &pile.position,
-                        velocity: &mut velocity,
-                        inverse_mass: &pile.inverse_mass,
-                    };
+                    let bodies = Bodies::new(&pile.position, &mut velocity, &pile.inverse_mass);
                     black_box(project_chain(
                         chain,
                         bodies,
@@ -227,11 +223,7 @@ fn structure_projection(c: &mut Criterion) {
                         closed: false,
                     }),
                 };
-                let bodies = Bodies {
-                    position: &structure.position,
-                    velocity: &mut velocity,
-                    inverse_mass: &inverse_mass,
-                };
+                let bodies = Bodies::new(&structure.position, &mut velocity, &inverse_mass);
                 black_box(project_island(
                     island,
                     bodies,

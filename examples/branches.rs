@@ -5,16 +5,12 @@
 
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
-use bevy_strands::render::{ActiveScene, StrandsRenderPlugin, StrandsUiPlugin, window_plugins};
+use bevy_strands_app::window::{ActiveScenario, DemoPlugins, window_plugins};
 
 fn main() -> AppExit {
     App::new()
         .add_plugins(window_plugins("branches"))
-        .add_plugins((
-            StrandsPlugin::default(),
-            StrandsRenderPlugin,
-            StrandsUiPlugin,
-        ))
-        .insert_resource(ActiveScene::builtin("branches"))
+        .add_plugins((StrandsPlugin::default(), DemoPlugins))
+        .insert_resource(ActiveScenario::builtin("branches").expect("a built-in scenario"))
         .run()
 }

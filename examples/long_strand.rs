@@ -1,20 +1,16 @@
 //! One free strand falls tilted onto the floor and piles up.
 //!
-//! `cargo run --release --example long_strand --features render`. The panel on the right
+//! `cargo run --release --features render --example long_strand`. The panel on the right
 //! holds the controls, the live figures and the mouse tools.
 
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
-use bevy_strands::render::{ActiveScene, StrandsRenderPlugin, StrandsUiPlugin, window_plugins};
+use bevy_strands_app::window::{ActiveScenario, DemoPlugins, window_plugins};
 
 fn main() -> AppExit {
     App::new()
         .add_plugins(window_plugins("long strand"))
-        .add_plugins((
-            StrandsPlugin::default(),
-            StrandsRenderPlugin,
-            StrandsUiPlugin,
-        ))
-        .insert_resource(ActiveScene::builtin("long_strand"))
+        .add_plugins((StrandsPlugin::default(), DemoPlugins))
+        .insert_resource(ActiveScenario::builtin("long_strand").expect("a built-in scenario"))
         .run()
 }

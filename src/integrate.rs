@@ -7,9 +7,11 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::config::StrandsConfig;
-use crate::schedule::SimulationClock;
-use crate::state::ParticleState;
+use crate::model::motion::end_of_step;
+use crate::schedule::{StepSet, StrandsStep};
+use crate::world::clock::SimulationClock;
+use crate::world::config::StrandsConfig;
+use crate::world::state::ParticleState;
 
 /// `v += dt w f` for every particle.
 pub fn predict_velocities(velocity: &mut [DVec2], force: &[DVec2], inverse_mass: &[f64], dt: f64) {
@@ -18,10 +20,25 @@ pub fn predict_velocities(velocity: &mut [DVec2], force: &[DVec2], inverse_mass:
     }
 }
 
-/// `x += dt v` for every particle.
+/// Every particle to the end of its step's motion, `x += dt v`.
 pub fn advance_positions(position: &mut [DVec2], velocity: &[DVec2], dt: f64) {
     for (x, &v) in position.iter_mut().zip(velocity) {
-        *x += dt * v;
+        *x = end_of_step(*x, v, dt);
+    }
+}
+
+/// The Predict and Integrate stages.
+pub struct IntegratorPlugin;
+
+impl Plugin for IntegratorPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            StrandsStep,
+            (
+                predict.in_set(StepSet::Predict),
+                integrate.in_set(StepSet::Integrate),
+            ),
+        );
     }
 }
 

@@ -2,10 +2,11 @@
 //!
 //! 2D strands — spaghetti, ropes, hair — whose edges never stretch, as a Bevy plugin.
 //!
-//! Particles are entities with [`Position`](particle::Position),
-//! [`Velocity`](particle::Velocity) and [`Mass`](particle::Mass); a strand is an entity
-//! whose [`Strand`](strand::Strand) lists its particles in order. Each fixed tick runs
-//! `substeps` steps through the stages of [`StepSet`](schedule::StepSet).
+//! Particles are entities with [`Position`](world::particle::Position),
+//! [`Velocity`](world::particle::Velocity) and [`Mass`](world::particle::Mass); a strand
+//! is an entity whose [`Strand`](world::strand::Strand) lists its particles in order.
+//! Each fixed tick runs `substeps` steps through the stages of
+//! [`StepSet`](schedule::StepSet); `schedule.rs` is the one place that fixes their order.
 //!
 //! ```
 //! use bevy::prelude::*;
@@ -24,51 +25,64 @@
 //! assert_eq!(app.world().resource::<SimulationClock>().steps, 30);
 //! # let _ = rope;
 //! ```
+//!
+//! The layers, bottom up: [`model`] (plain data and rules), the kernels in [`forces`],
+//! [`constraints`] and [`collision`] (slices in, slices out), the ECS layer in [`world`],
+//! and the systems and plugins on top ([`schedule`], each area's `plugin`,
+//! [`contact_loop`], [`metrics`]). The repository's `docs/ARCHITECTURE.md` walks through
+//! them.
+
+#![warn(missing_docs)]
 
 pub mod collision;
-pub mod config;
 pub mod constraints;
-pub mod export;
+pub mod contact_loop;
 pub mod forces;
 pub mod integrate;
 pub mod metrics;
-pub mod particle;
+pub mod model;
 #[cfg(feature = "render")]
 pub mod render;
-pub mod report;
-pub mod runner;
-pub mod scene;
-pub mod scenes;
 pub mod schedule;
-pub mod state;
-pub mod strand;
-pub mod tools;
-pub mod topology;
+pub mod world;
 
 use bevy::app::PluginGroupBuilder;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 
 use collision::CollisionPlugin;
-use config::StrandsConfig;
 use constraints::ConstraintsPlugin;
-use metrics::StrandMetrics;
-use scenes::ScenesPlugin;
-use schedule::{SchedulePlugin, SimulationClock};
-use state::ParticleState;
-use topology::{InputProblems, Topology};
+use contact_loop::ContactLoopPlugin;
+use forces::ForcesPlugin;
+use integrate::IntegratorPlugin;
+use metrics::MetricsPlugin;
+use schedule::{SchedulePlugin, StrandsTick, TickSet};
+use world::clock::SimulationClock;
+use world::config::StrandsConfig;
+use world::hooks::TopologyDirty;
+use world::problems::InputProblems;
+use world::state::ParticleState;
+use world::sync::{gather, write_back};
+use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_dirty};
 
 /// Everything most users need.
 pub mod prelude {
-    pub use crate::collision::{CollisionConfig, CollisionPlugin};
-    pub use crate::config::StrandsConfig;
-    pub use crate::constraints::{ConstraintConfig, ConstraintsPlugin, SolverKind};
+    pub use crate::collision::CollisionPlugin;
+    pub use crate::constraints::{ConstraintsPlugin, SolverKind};
     pub use crate::metrics::StrandMetrics;
-    pub use crate::particle::{ExternalForce, Mass, Particle, Pinned, Position, Velocity};
-    pub use crate::schedule::{SimulationClock, StepSet, StrandsStep, StrandsTick, TickSet};
-    pub use crate::state::ParticleState;
-    pub use crate::strand::{Strand, StrandBuilder, StrandKind, StrandMaterial, StrandOf};
-    pub use crate::topology::{InputProblems, Topology};
+    pub use crate::schedule::{CollideSet, StepSet, StrandsStep, StrandsTick, TickSet};
+    pub use crate::world::builder::StrandBuilder;
+    pub use crate::world::clock::SimulationClock;
+    pub use crate::world::config::{
+        CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig,
+    };
+    pub use crate::world::particle::{
+        ExternalForce, Mass, Particle, Pinned, Position, Tether, Velocity,
+    };
+    pub use crate::world::problems::InputProblems;
+    pub use crate::world::state::ParticleState;
+    pub use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
+    pub use crate::world::topology::Topology;
     pub use crate::{StrandsCorePlugin, StrandsPlugin};
 }
 
@@ -109,13 +123,17 @@ impl PluginGroup for StrandsPlugin {
             .add(StrandsCorePlugin {
                 driver: self.driver,
             })
+            .add(ForcesPlugin)
+            .add(IntegratorPlugin)
+            .add(MetricsPlugin)
             .add(ConstraintsPlugin)
             .add(CollisionPlugin)
-            .add(ScenesPlugin)
+            .add(ContactLoopPlugin)
     }
 }
 
-/// Particles, strands, the step schedule, forces, integration and metrics.
+/// The schedules, particles, strands, the topology and the packed state: what every
+/// other plugin of the crate builds on.
 #[derive(Clone, Debug)]
 pub struct StrandsCorePlugin {
     /// The schedule that runs a tick; `None` to drive by hand.
@@ -127,23 +145,33 @@ impl Plugin for StrandsCorePlugin {
         app.init_resource::<StrandsConfig>()
             .init_resource::<ParticleState>()
             .init_resource::<Topology>()
+            .init_resource::<TopologyDirty>()
             .init_resource::<InputProblems>()
             .init_resource::<SimulationClock>()
-            .init_resource::<StrandMetrics>()
             .register_type::<StrandsConfig>()
             .register_type::<SimulationClock>()
-            .register_type::<particle::Particle>()
-            .register_type::<particle::Position>()
-            .register_type::<particle::Velocity>()
-            .register_type::<particle::Mass>()
-            .register_type::<particle::Pinned>()
-            .register_type::<particle::ExternalForce>()
-            .register_type::<strand::Strand>()
-            .register_type::<strand::StrandMaterial>()
-            .register_type::<strand::StrandKind>()
-            .register_type::<forces::tether::Tether>()
+            .register_type::<world::particle::Particle>()
+            .register_type::<world::particle::Position>()
+            .register_type::<world::particle::Velocity>()
+            .register_type::<world::particle::Mass>()
+            .register_type::<world::particle::Pinned>()
+            .register_type::<world::particle::ExternalForce>()
+            .register_type::<world::particle::Tether>()
+            .register_type::<world::strand::Strand>()
+            .register_type::<world::strand::StrandMaterial>()
+            .register_type::<world::strand::StrandKind>()
             .add_plugins(SchedulePlugin {
                 driver: self.driver,
-            });
+            })
+            .add_systems(
+                StrandsTick,
+                (
+                    (detect_strand_edits, rebuild_topology.run_if(topology_dirty))
+                        .chain()
+                        .in_set(TickSet::Topology),
+                    gather.in_set(TickSet::Gather),
+                    write_back.in_set(TickSet::Writeback),
+                ),
+            );
     }
 }

@@ -5,12 +5,35 @@
 //! every step. It is also kept separately for edges none of whose particles took part
 //! in a contact that step, because contact impulses come after the constraint solve.
 
-use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::constraints::projection::ProjectionOutcome;
-use crate::state::ParticleState;
-use crate::topology::{Edge, Topology};
+use crate::model::edge::measure_length_errors;
+use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet, stepping};
+use crate::world::clock::SimulationClock;
+use crate::world::state::ParticleState;
+use crate::world::topology::{Topology, rebuild_topology};
+
+/// The figures of merit: length errors every step, counts after every rebuild, and the
+/// length-error history when one is kept.
+pub struct MetricsPlugin;
+
+impl Plugin for MetricsPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<StrandMetrics>()
+            .add_systems(
+                StrandsTick,
+                (
+                    count_elements
+                        .in_set(TickSet::Topology)
+                        .after(rebuild_topology),
+                    begin_tick.in_set(TickSet::Gather).run_if(stepping),
+                    record_length_error_history.in_set(TickSet::Writeback),
+                ),
+            )
+            .add_systems(StrandsStep, measure.in_set(StepSet::Measure));
+    }
+}
 
 /// Running totals of a constraint solver's iterations.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -93,10 +116,6 @@ pub struct StrandMetrics {
     /// Step ends at which two edges sharing no particle intersected; `None` when not
     /// checked.
     pub edge_crossings: Option<u64>,
-    /// Wall-clock seconds spent stepping.
-    pub wall_seconds: f64,
-    /// Wall-clock seconds of the latest tick.
-    pub last_tick_seconds: f64,
 }
 
 impl StrandMetrics {
@@ -112,35 +131,6 @@ impl StrandMetrics {
             ..Self::default()
         };
     }
-}
-
-/// `|ℓ − L| / L` of an edge.
-pub fn relative_length_error(edge: &Edge, position: &[DVec2]) -> f64 {
-    let length = position[edge.a as usize].distance(position[edge.b as usize]);
-    (length - edge.rest_length).abs() / edge.rest_length
-}
-
-/// Relative length error of every edge into `errors`; returns the maxima over all
-/// dynamic edges and over those with no particle in contact.
-pub fn measure_length_errors(
-    edges: &[Edge],
-    position: &[DVec2],
-    in_contact: &[bool],
-    errors: &mut [f64],
-) -> (f64, f64) {
-    let (mut all, mut free) = (0.0f64, 0.0f64);
-    for (edge, error) in edges.iter().zip(errors.iter_mut()) {
-        *error = if edge.is_static {
-            0.0
-        } else {
-            relative_length_error(edge, position)
-        };
-        all = all.max(*error);
-        if !(in_contact[edge.a as usize] || in_contact[edge.b as usize]) {
-            free = free.max(*error);
-        }
-    }
-    (all, free)
 }
 
 /// The Measure stage's length figures.
@@ -191,7 +181,7 @@ pub struct LengthErrorHistory {
 /// Append the tick's sample to the history, if one is kept.
 pub fn record_length_error_history(
     metrics: Res<StrandMetrics>,
-    clock: Res<crate::schedule::SimulationClock>,
+    clock: Res<SimulationClock>,
     history: Option<ResMut<LengthErrorHistory>>,
 ) {
     if let Some(mut history) = history {
@@ -201,6 +191,12 @@ pub fn record_length_error_history(
             free: metrics.tick_max_rel_length_error_free,
         });
     }
+}
+
+/// Forget the previous tick's maxima (start of a tick that steps).
+pub fn begin_tick(mut metrics: ResMut<StrandMetrics>) {
+    metrics.tick_max_rel_length_error = 0.0;
+    metrics.tick_max_rel_length_error_free = 0.0;
 }
 
 /// Refresh the counts after a topology rebuild.

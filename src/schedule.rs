@@ -1,30 +1,39 @@
 //! The order of a step, in one place.
 //!
-//! A fixed tick ([`StrandsTick`]) prepares the topology, gathers entity state into the
-//! packed arrays, runs `substeps` steps of [`StrandsStep`], and writes the state back.
-//! A step runs the stages of [`StepSet`] in order:
+//! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, the
+//! topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
+//! the step schedule, and the write-back. A step ([`StrandsStep`]) runs the stages of
+//! [`StepSet`] in order:
 //!
-//! 1. **Forces** — external forces, gravity, damping, springs, bending.
+//! 1. **Forces** — external forces, gravity, damping, springs, bending, tethers.
 //! 2. **Predict** — symplectic Euler predictor `v* = v + dt f / m`.
 //! 3. **Constrain** — impulses so every constrained edge ends the step at rest length.
-//! 4. **Collide** — continuous point–edge collision impulses, then the fail-safe.
+//! 4. **Collide** — the sub-stages of [`CollideSet`], in order:
+//!    1. **Proximity** — candidate pairs for the step's motion; pairs that would end
+//!       the step closer than the thickness are pushed apart.
+//!    2. **Impulses** — continuous point–edge detection, an impulse per collision,
+//!       repeated until a pass finds none; the rigid-impact-zone fail-safe if the cap
+//!       is reached.
+//!    3. **Contact loop** — the islands contacts touched are projected onto their
+//!       constraints again with every contact as an inequality row, then the
+//!       Impulses sub-stage's detection runs again; repeated until a pass applies no
+//!       impulse. Collisions always come last, so non-penetration is never traded for
+//!       length.
+//!    4. **Account** — the step's collision figures.
 //! 5. **Integrate** — `x += dt v`.
 //! 6. **Measure** — length errors, crossings, counts.
 //!
-//! Tests drive the simulation with `world.run_schedule(StrandsTick)`: no wall clock.
+//! Each area's plugin adds its systems to these sets; this module fixes their order
+//! and runs the steps. Tests drive the simulation with `world.run_schedule(StrandsTick)`:
+//! no wall clock.
 
 use bevy::ecs::schedule::{InternedScheduleLabel, LogLevel, ScheduleBuildSettings, ScheduleLabel};
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::time::Fixed;
 
-use crate::config::StrandsConfig;
-use crate::forces::accumulate_forces;
-use crate::forces::tether::apply_tethers;
-use crate::integrate::{integrate, predict};
-use crate::metrics::{StrandMetrics, count_elements, measure, record_length_error_history};
-use crate::state::{gather, write_back};
-use crate::topology::{detect_strand_edits, rebuild_topology, topology_dirty};
+use crate::world::clock::StepTiming;
+use crate::world::config::StrandsConfig;
 
 /// One fixed tick: prepare, gather, `substeps` steps, write back.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -49,7 +58,7 @@ pub enum TickSet {
     Writeback,
 }
 
-/// The stages of a step, in order (DESIGN §4).
+/// The stages of a step, in order.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum StepSet {
     /// Accumulate forces.
@@ -58,7 +67,7 @@ pub enum StepSet {
     Predict,
     /// Inextensibility: filter the velocities so every constrained edge keeps its length.
     Constrain,
-    /// Continuous collision impulses and the fail-safe.
+    /// Collision processing: the sub-stages of [`CollideSet`].
     Collide,
     /// Advance positions.
     Integrate,
@@ -66,26 +75,22 @@ pub enum StepSet {
     Measure,
 }
 
-/// Simulated time and steps taken.
-#[derive(Resource, Reflect, Clone, Copy, Debug, Default, PartialEq)]
-#[reflect(Resource)]
-pub struct SimulationClock {
-    /// Simulated seconds since start.
-    pub time: f64,
-    /// Steps taken since start.
-    pub steps: u64,
+/// The sub-stages of [`StepSet::Collide`], in order.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CollideSet {
+    /// Candidate pairs from the broad phase; proximity impulses keep pairs a thickness
+    /// apart.
+    Proximity,
+    /// Continuous detection with impulses until a pass is clean, then the fail-safe.
+    Impulses,
+    /// Re-projection of the islands in contact with contact rows, alternating with
+    /// detection and impulses until nothing changes.
+    ContactLoop,
+    /// The step's collision counts.
+    Account,
 }
 
-impl SimulationClock {
-    /// Account for one step of `dt`.
-    pub fn advance(&mut self, dt: f64) {
-        self.steps += 1;
-        // Multiply rather than accumulate so long runs do not drift.
-        self.time = self.steps as f64 * dt;
-    }
-}
-
-/// Sets up the two schedules, their stages and the core systems.
+/// Sets up the two schedules and the order of their sets, and runs the steps.
 pub struct SchedulePlugin {
     /// The schedule that runs a tick each time it runs; `None` to drive by hand.
     pub driver: Option<InternedScheduleLabel>,
@@ -101,6 +106,7 @@ impl Plugin for SchedulePlugin {
         step.set_executor(bevy::ecs::schedule::SingleThreadedExecutor::new());
         app.add_schedule(step);
         app.init_schedule(StrandsTick);
+        app.init_resource::<StepTiming>();
 
         app.configure_sets(
             StrandsTick,
@@ -125,31 +131,18 @@ impl Plugin for SchedulePlugin {
             )
                 .chain(),
         );
-        app.add_systems(
-            StrandsTick,
-            (
-                (detect_strand_edits, rebuild_topology.run_if(topology_dirty))
-                    .chain()
-                    .in_set(TickSet::Topology),
-                count_elements
-                    .in_set(TickSet::Topology)
-                    .after(rebuild_topology),
-                gather.in_set(TickSet::Gather),
-                run_steps.in_set(TickSet::Step),
-                (write_back, record_length_error_history).in_set(TickSet::Writeback),
-            ),
-        );
-        app.add_systems(
+        app.configure_sets(
             StrandsStep,
             (
-                (accumulate_forces, apply_tethers)
-                    .chain()
-                    .in_set(StepSet::Forces),
-                predict.in_set(StepSet::Predict),
-                integrate.in_set(StepSet::Integrate),
-                measure.in_set(StepSet::Measure),
-            ),
+                CollideSet::Proximity,
+                CollideSet::Impulses,
+                CollideSet::ContactLoop,
+                CollideSet::Account,
+            )
+                .chain()
+                .in_set(StepSet::Collide),
         );
+        app.add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
 
         if let Some(driver) = self.driver {
             app.add_systems(driver, drive_tick);
@@ -161,7 +154,13 @@ impl Plugin for SchedulePlugin {
 /// While set, a tick only synchronises (topology, gather, write-back) and takes no step:
 /// what a paused simulation runs, so that edits made while paused show at once.
 #[derive(Resource, Default, Clone, Copy, Debug)]
-struct SyncOnly(bool);
+pub struct SyncOnly(bool);
+
+/// Run condition: this tick takes steps (it is not a paused tick that only
+/// synchronises).
+pub fn stepping(sync: Option<Res<SyncOnly>>) -> bool {
+    !sync.is_some_and(|s| s.0)
+}
 
 /// Run `substeps` steps and account their wall time.
 fn run_steps(world: &mut World) {
@@ -169,11 +168,6 @@ fn run_steps(world: &mut World) {
         return;
     }
     let substeps = world.resource::<StrandsConfig>().substeps;
-    {
-        let mut metrics = world.resource_mut::<StrandMetrics>();
-        metrics.tick_max_rel_length_error = 0.0;
-        metrics.tick_max_rel_length_error_free = 0.0;
-    }
     let start = Instant::now();
     world.schedule_scope(StrandsStep, |world, schedule| {
         for _ in 0..substeps {
@@ -181,9 +175,9 @@ fn run_steps(world: &mut World) {
         }
     });
     let seconds = start.elapsed().as_secs_f64();
-    let mut metrics = world.resource_mut::<StrandMetrics>();
-    metrics.wall_seconds += seconds;
-    metrics.last_tick_seconds = seconds;
+    let mut timing = world.resource_mut::<StepTiming>();
+    timing.wall_seconds += seconds;
+    timing.last_tick_seconds = seconds;
 }
 
 /// Run one tick (the driver schedule's system); paused, one that takes no step.

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
-use bevy_strands::runner::{RunOptions, headless_app, load_scene};
+use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
 
 struct CountingAllocator;
 
@@ -50,7 +50,7 @@ fn steady_state_steps_and_ticks_allocate_nothing() {
 }
 
 fn steady_state_allocates_nothing(scenario: &str) {
-    let scene = load_scene(&RunOptions {
+    let scene = load_scenario(&RunOptions {
         scenario: scenario.into(),
         ..Default::default()
     })

@@ -2,13 +2,11 @@
 //! momentum, friction, and exact lengths through contact. Crossings are checked at the
 //! end of every step.
 
-mod common;
-
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::broad_phase::BroadPhaseMethod;
 use bevy_strands::prelude::*;
-use common::*;
+use bevy_strands_app::fixtures::*;
 
 #[test]
 fn a_fast_particle_does_not_tunnel_through_a_thin_pinned_edge() {

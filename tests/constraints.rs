@@ -1,14 +1,12 @@
 //! Inextensibility through the whole app: islands, the Constrain stage, momentum.
 
-mod common;
-
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::constraints::Islands;
 use bevy_strands::constraints::islands::IslandKind;
 use bevy_strands::constraints::projection::ConstraintDirection;
 use bevy_strands::prelude::*;
-use common::*;
+use bevy_strands_app::fixtures::*;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 

@@ -1,12 +1,10 @@
 //! The core: data model, step pipeline, forces and integration, headless on
 //! `MinimalPlugins`.
 
-mod common;
-
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
-use common::*;
+use bevy_strands_app::fixtures::*;
 
 fn spawn_particle(app: &mut App, x: DVec2, v: DVec2) -> Entity {
     app.world_mut()
@@ -314,7 +312,9 @@ fn an_invalid_strand_component_is_left_out_with_a_message() {
         "{}",
         message(one)
     );
-    assert!(message(negative).contains("rest length of edge 0 is -0.1"));
+    assert!(
+        message(negative).contains("rest length of edge 0 must be positive and finite, got -0.1")
+    );
     assert_eq!(app.world().resource::<StrandMetrics>().strands, 0);
 }
 

@@ -1,14 +1,11 @@
 //! The mouse tools' logic, driven headless: what each tool does to the world, and that
 //! the simulation takes it up cleanly on the next tick.
 
-mod common;
-
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy_strands::forces::tether::Tether;
 use bevy_strands::prelude::*;
-use bevy_strands::tools::*;
-use common::*;
+use bevy_strands::world::edit::*;
+use bevy_strands_app::fixtures::*;
 
 #[test]
 fn creating_a_particle_puts_a_simulated_particle_at_the_point() {

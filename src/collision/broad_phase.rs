@@ -9,10 +9,11 @@
 use bevy::math::DVec2;
 use bevy::prelude::Reflect;
 
-use crate::topology::Edge;
+use crate::model::Edge;
 
 /// How candidate pairs are found.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum BroadPhaseMethod {
     /// Uniform hashed grid: near-linear.
     #[default]

@@ -171,21 +171,10 @@ fn collinear_contact(
         .and_then(|t| hit_at(t, p, dp, q, dq, r, dr))
 }
 
-/// Closest point of segment q–r to p: its α in [0, 1] and the distance.
-pub fn closest_on_segment(p: DVec2, q: DVec2, r: DVec2) -> (f64, f64) {
-    let edge = r - q;
-    let length_squared = edge.length_squared();
-    let alpha = if length_squared > 0.0 {
-        ((p - q).dot(edge) / length_squared).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (alpha, p.distance(q + alpha * edge))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::geometry::closest_on_segment;
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
 

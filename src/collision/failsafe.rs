@@ -10,10 +10,12 @@
 
 use bevy::math::DVec2;
 
+use crate::model::UnionFind;
+
 /// Zone membership and per-zone sums, reused between steps.
 #[derive(Clone, Debug, Default)]
 pub struct ImpactZones {
-    parent: Vec<u32>,
+    sets: UnionFind,
     translation_only: Vec<bool>,
     members: Vec<u32>,
     in_zone: Vec<bool>,
@@ -29,8 +31,7 @@ pub struct ImpactZones {
 impl ImpactZones {
     /// Every particle in a zone of its own.
     pub fn reset(&mut self, particles: usize) {
-        self.parent.clear();
-        self.parent.extend(0..particles as u32);
+        self.sets.reset(particles);
         for flags in [&mut self.translation_only, &mut self.in_zone] {
             flags.clear();
             flags.resize(particles, false);
@@ -39,13 +40,8 @@ impl ImpactZones {
     }
 
     /// The zone of particle `i`.
-    pub fn zone(&mut self, mut i: usize) -> usize {
-        while self.parent[i] as usize != i {
-            let grandparent = self.parent[self.parent[i] as usize];
-            self.parent[i] = grandparent;
-            i = grandparent as usize;
-        }
-        i
+    pub fn zone(&mut self, i: usize) -> usize {
+        self.sets.find(i)
     }
 
     /// Put `a` and `b` in one zone; whether anything changed.
@@ -56,14 +52,13 @@ impl ImpactZones {
                 self.members.push(i as u32);
             }
         }
-        let (za, zb) = (self.zone(a), self.zone(b));
-        if za == zb {
-            return false;
+        match self.sets.union(a, b) {
+            Some((keep, merged)) => {
+                self.translation_only[keep] |= self.translation_only[merged];
+                true
+            }
+            None => false,
         }
-        let (keep, merged) = (za.min(zb), za.max(zb));
-        self.parent[merged] = keep as u32;
-        self.translation_only[keep] |= self.translation_only[merged];
-        true
     }
 
     /// Make the zone of `i` translate only; whether it rotated before.
@@ -75,6 +70,11 @@ impl ImpactZones {
     /// The particles in any zone.
     pub fn members(&self) -> &[u32] {
         &self.members
+    }
+
+    /// Whether each particle is in a zone, by packed index.
+    pub fn in_zone(&self) -> &[bool] {
+        &self.in_zone
     }
 
     /// Give every zone's members the zone's rigid velocity.

@@ -1,11 +1,11 @@
 //! The layout of a tree or graph island, built once per topology change: its particles
 //! in local numbering, each edge's ends, the edges at each particle, and the sparse
-//! plan of its system `J W Jᵀ` (DESIGN §5: "better solvers" for branching structures).
+//! plan of its system `J W Jᵀ`.
 //!
 //! The island's edges are put in the plan's elimination order, so that edge k is
 //! unknown k of the factor and the projection needs no permutation.
 
-use super::islands::IslandEdge;
+use super::island_edge::IslandEdge;
 use super::sparse::SparsePlan;
 
 /// An off-diagonal entry of `J W Jᵀ`: edges k and l meet at a free particle.

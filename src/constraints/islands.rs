@@ -7,10 +7,9 @@
 
 use std::ops::Range;
 
-use bevy::math::DVec2;
-
 use super::graph::GraphLayout;
-use crate::topology::Edge;
+use super::island_edge::IslandEdge;
+use crate::model::{Edge, UnionFind};
 
 /// The shape of an island's constraint graph.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -34,36 +33,6 @@ impl IslandKind {
             IslandKind::Tree => "tree",
             IslandKind::Graph => "graph",
         }
-    }
-}
-
-/// An edge of an island, oriented along the island's order.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct IslandEdge {
-    /// Start particle (packed index).
-    pub a: u32,
-    /// End particle (packed index).
-    pub b: u32,
-    /// Rest length.
-    pub rest_length: f64,
-    /// Index in [`Topology::edges`](crate::topology::Topology::edges).
-    pub edge: u32,
-}
-
-impl IslandEdge {
-    /// Edges joining `pairs` of `points`, each at its current length, numbered in order
-    /// (for kernels used without a topology: tests, benchmarks, tools).
-    pub fn between(points: &[DVec2], pairs: &[(u32, u32)]) -> Vec<IslandEdge> {
-        pairs
-            .iter()
-            .enumerate()
-            .map(|(k, &(a, b))| IslandEdge {
-                a,
-                b,
-                rest_length: points[a as usize].distance(points[b as usize]),
-                edge: k as u32,
-            })
-            .collect()
     }
 }
 
@@ -102,7 +71,7 @@ pub fn find_islands(edges: &[Edge], pinned: &[bool]) -> IslandSet {
     let mut roots = UnionFind::new(n);
     for e in edges.iter().filter(|e| !e.is_static) {
         if !pinned[e.a as usize] && !pinned[e.b as usize] {
-            roots.union(e.a as usize, e.b as usize);
+            let _ = roots.union(e.a as usize, e.b as usize);
         }
     }
     // Group edges by the root of their free end (every dynamic edge has one).
@@ -279,35 +248,6 @@ fn order_chain(
         }
         at = next;
         via = following;
-    }
-}
-
-/// Disjoint sets with path halving.
-struct UnionFind {
-    parent: Vec<u32>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        Self {
-            parent: (0..n as u32).collect(),
-        }
-    }
-
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] as usize != x {
-            let grandparent = self.parent[self.parent[x] as usize];
-            self.parent[x] = grandparent;
-            x = grandparent as usize;
-        }
-        x
-    }
-
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra.max(rb)] = ra.min(rb) as u32;
-        }
     }
 }
 

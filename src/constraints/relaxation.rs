@@ -1,4 +1,4 @@
-//! Relaxation baselines (DESIGN §5): Jacobi and Gauss–Seidel projection of one
+//! Relaxation baselines: Jacobi and Gauss–Seidel projection of one
 //! distance constraint at a time, as position-based engines do (zero-compliance XPBD
 //! moves the particles exactly as Gauss–Seidel does). Kept so that every figure of the
 //! exact solve can be shown beside what most engines do.
@@ -12,7 +12,7 @@
 
 use bevy::math::DVec2;
 
-use super::islands::IslandEdge;
+use super::island_edge::IslandEdge;
 use super::projection::{Bodies, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
 
 /// How the sweeps use the corrections.
@@ -61,6 +61,7 @@ pub fn relax(
         position,
         velocity,
         inverse_mass: w,
+        ..
     } = bodies;
     scratch.reserve(position.len(), edges.len());
     let s = scratch;
@@ -201,11 +202,7 @@ mod tests {
         let mut scratch = RelaxationScratch::default();
         let mut run = |method, sweeps| {
             let mut velocity = initial.clone();
-            let bodies = Bodies {
-                position: &position,
-                velocity: &mut velocity,
-                inverse_mass: &inverse_mass,
-            };
+            let bodies = Bodies::new(&position, &mut velocity, &inverse_mass);
             let outcome = relax(&edges, bodies, dt, method, &settings(sweeps), &mut scratch);
             let momentum: DVec2 = velocity.iter().sum();
             (error(&position, &velocity, &edges, dt), outcome, momentum)

@@ -1,7 +1,7 @@
 //! The Thomas algorithm: a tridiagonal system in O(n), without pivoting.
 //!
 //! Safe without pivoting for the symmetric positive definite matrices of open strands
-//! (DESIGN §5) and for the nearly symmetric ones of the start-of-step direction. A
+//! and for the nearly symmetric ones of the start-of-step direction. A
 //! pivot that is not positive-finite relative to its row reports the system singular
 //! instead of returning garbage.
 

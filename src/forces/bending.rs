@@ -5,11 +5,10 @@
 //! K = k_b / ℓ̄. Its gradient: ∂θ/∂x_a = e₁⊥/|e₁|², ∂θ/∂x_b = e₂⊥/|e₂|², and ∂θ/∂x_s
 //! their negated sum. Damping acts on the angle rate θ̇ = Σ ∂θ/∂x_i · v_i.
 
-use std::f64::consts::{PI, TAU};
-
 use bevy::math::DVec2;
 
-use crate::topology::Bend;
+use crate::model::Bend;
+use crate::model::geometry::{turning_angle, wrap_angle};
 
 /// Add the bending force of every element.
 pub fn add_bending(bends: &[Bend], position: &[DVec2], velocity: &[DVec2], force: &mut [DVec2]) {
@@ -21,7 +20,7 @@ pub fn add_bending(bends: &[Bend], position: &[DVec2], velocity: &[DVec2], force
         if l1 == 0.0 || l2 == 0.0 {
             continue;
         }
-        let theta = e1.perp_dot(e2).atan2(e1.dot(e2));
+        let theta = turning_angle(e1, e2);
         let grad_a = e1.perp() / l1;
         let grad_b = e2.perp() / l2;
         let grad_s = -(grad_a + grad_b);
@@ -32,12 +31,6 @@ pub fn add_bending(bends: &[Bend], position: &[DVec2], velocity: &[DVec2], force
         force[s] += magnitude * grad_s;
         force[b] += magnitude * grad_b;
     }
-}
-
-/// The angle in (−π, π].
-pub fn wrap_angle(angle: f64) -> f64 {
-    let wrapped = (angle + PI).rem_euclid(TAU) - PI;
-    if wrapped == -PI { PI } else { wrapped }
 }
 
 #[cfg(test)]
@@ -83,12 +76,5 @@ mod tests {
         }
         let total: DVec2 = force.iter().sum();
         assert!(total.length() < 1e-12);
-    }
-
-    #[test]
-    fn angles_wrap_into_half_open_interval() {
-        assert!((wrap_angle(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
-        assert_eq!(wrap_angle(-PI), PI);
-        assert_eq!(wrap_angle(0.25), 0.25);
     }
 }

@@ -6,7 +6,7 @@
 
 use bevy::math::DVec2;
 
-use crate::topology::Edge;
+use crate::model::Edge;
 
 /// Add the spring force of every edge with `spring` set.
 pub fn add_stretch_springs(

@@ -1,0 +1,169 @@
+//! The run report: one JSON object, or a readable table.
+
+use serde::Serialize;
+
+/// Constraint islands by kind and by the solver that took them.
+#[derive(Serialize, Clone, Debug, Default, PartialEq)]
+pub struct IslandReport {
+    /// Chains (open strands, or pieces between pins): Thomas.
+    pub path: usize,
+    /// Loops: Sherman–Morrison on top of Thomas.
+    pub cycle: usize,
+    /// Branching islands.
+    pub tree: usize,
+    /// Islands with several loops or redundant edges.
+    pub graph: usize,
+    /// Islands the configured solver could not take; their edges are stretch springs.
+    pub unsolved: usize,
+    /// The solver of each kind, e.g. `path: thomas`.
+    pub solvers: Vec<String>,
+}
+
+/// Figures of one headless run.
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct Report {
+    /// Scenario name.
+    pub scenario: String,
+    /// The scene parameters actually used (dt, substeps and solver included).
+    pub config: serde_json::Value,
+    /// The constraint solver used.
+    pub solver: String,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated seconds.
+    pub sim_time: f64,
+    /// Particles at the end.
+    pub particles: usize,
+    /// Strands at the end (walls included).
+    pub strands: usize,
+    /// Edges kept at rest length by the constraint solver at the end.
+    pub constrained_edges: usize,
+    /// The constraint islands at the end, by kind, and which solver took them.
+    pub islands: IslandReport,
+    /// Largest `|ℓ − L| / L` over every non-static edge and every step end.
+    pub max_rel_length_error: f64,
+    /// The same over edges with no particle in contact that step.
+    pub max_rel_length_error_free: f64,
+    /// Step ends at which two edges sharing no particle intersected; null if unchecked.
+    pub edge_crossings: Option<u64>,
+    /// Collision impulses applied.
+    pub collisions: u64,
+    /// Steps that needed the collision fail-safe.
+    pub failsafe_steps: u64,
+    /// Mean constraint-solve iterations per island per step.
+    pub projection_iterations_mean: f64,
+    /// Most constraint-solve iterations of any island in any step.
+    pub projection_iterations_max: u32,
+    /// Island solves that stopped at the iteration cap.
+    pub projection_capped_solves: u64,
+    /// Re-projections of islands in contact (the contact loop): solves, mean and most
+    /// iterations, and solves that stopped at the cap.
+    pub contact_projection_solves: u64,
+    /// Mean iterations of a re-projection in contact.
+    pub contact_projection_iterations_mean: f64,
+    /// Most iterations of a re-projection in contact.
+    pub contact_projection_iterations_max: u32,
+    /// Re-projections in contact that stopped at the cap.
+    pub contact_projection_capped_solves: u64,
+    /// Re-projections in contact dropped because they asked for absurd corrections.
+    pub contact_projection_rejected_solves: u64,
+    /// Steps whose collisions still needed impulses after the last re-projection:
+    /// edges next to those contacts end the step as the impulses left them.
+    pub contact_unsettled_steps: u64,
+    /// Wall-clock seconds of the run's ticks.
+    pub wall_seconds: f64,
+    /// Particles × steps per wall-clock second.
+    pub particle_steps_per_second: f64,
+    /// What a reader must know to interpret the figures.
+    pub notes: Vec<String>,
+    /// Problems found in the input, and what was done about them.
+    pub input_problems: Vec<String>,
+    /// Pictures written (GIF, PNG frames, plot).
+    pub pictures: Vec<String>,
+}
+
+impl Report {
+    /// The report as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report always serializes")
+    }
+
+    /// The report as an aligned two-column table.
+    pub fn to_table(&self) -> String {
+        let crossings = self
+            .edge_crossings
+            .map_or("not checked".to_string(), |c| c.to_string());
+        let rows: Vec<(&str, String)> = vec![
+            ("scenario", self.scenario.clone()),
+            ("solver", self.solver.clone()),
+            ("steps", self.steps.to_string()),
+            ("sim_time", format!("{:.4} s", self.sim_time)),
+            ("particles", self.particles.to_string()),
+            ("strands", self.strands.to_string()),
+            ("constrained_edges", self.constrained_edges.to_string()),
+            (
+                "islands",
+                format!(
+                    "{} path, {} cycle, {} tree, {} graph; {} unsolved",
+                    self.islands.path,
+                    self.islands.cycle,
+                    self.islands.tree,
+                    self.islands.graph,
+                    self.islands.unsolved
+                ),
+            ),
+            (
+                "max_rel_length_error",
+                format!("{:.3e}", self.max_rel_length_error),
+            ),
+            (
+                "max_rel_length_error_free",
+                format!("{:.3e}", self.max_rel_length_error_free),
+            ),
+            ("edge_crossings", crossings),
+            ("collisions", self.collisions.to_string()),
+            ("failsafe_steps", self.failsafe_steps.to_string()),
+            (
+                "projection_iterations",
+                format!(
+                    "mean {:.2}, max {}, capped {}",
+                    self.projection_iterations_mean,
+                    self.projection_iterations_max,
+                    self.projection_capped_solves
+                ),
+            ),
+            (
+                "contact_projection",
+                format!(
+                    "{} solves, mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
+                    self.contact_projection_solves,
+                    self.contact_projection_iterations_mean,
+                    self.contact_projection_iterations_max,
+                    self.contact_projection_capped_solves,
+                    self.contact_projection_rejected_solves,
+                    self.contact_unsettled_steps
+                ),
+            ),
+            ("wall_seconds", format!("{:.3}", self.wall_seconds)),
+            (
+                "particle_steps_per_second",
+                format!("{:.3e}", self.particle_steps_per_second),
+            ),
+        ];
+        let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+        let mut out = String::new();
+        for (key, value) in rows {
+            out.push_str(&format!("{key:<width$}  {value}\n"));
+        }
+        for note in &self.notes {
+            out.push_str(&format!("note: {note}\n"));
+        }
+        for problem in &self.input_problems {
+            out.push_str(&format!("input problem: {problem}\n"));
+        }
+        for picture in &self.pictures {
+            out.push_str(&format!("wrote {picture}\n"));
+        }
+        out
+    }
+}

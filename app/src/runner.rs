@@ -1,0 +1,305 @@
+//! The headless runner: a scenario in, a report out, no window and no wall clock in
+//! the loop. The `strands` binary is a thin command line over [`run`].
+
+use std::path::PathBuf;
+
+use bevy::platform::time::Instant;
+use bevy::prelude::*;
+use thiserror::Error;
+
+use bevy_strands::constraints::Islands;
+use bevy_strands::constraints::islands::IslandKind;
+use bevy_strands::constraints::projection::ConstraintDirection;
+use bevy_strands::metrics::LengthErrorHistory;
+use bevy_strands::prelude::*;
+
+use crate::export::plot::plot_length_error;
+use crate::export::{ExportError, FrameSettings, Recorder};
+use crate::report::{IslandReport, Report};
+use crate::scenario::{Scenario, ScenarioError};
+use crate::scenes::{ScenesPlugin, builtin, builtin_names};
+use crate::spawn::spawn_scenario;
+
+/// What to run, and the command line's overrides of the scene.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Built-in scenario name (ignored when `scene_file` is given, except in errors).
+    pub scenario: String,
+    /// A scene file to run instead of the built-in one.
+    pub scene_file: Option<PathBuf>,
+    /// Simulated seconds, instead of the scene's duration.
+    pub seconds: Option<f64>,
+    /// Step size, instead of the scene's.
+    pub dt: Option<f64>,
+    /// Steps per tick, instead of the scene's.
+    pub substeps: Option<u32>,
+    /// Constraint solver, instead of the scene's.
+    pub solver: Option<String>,
+    /// Projection iteration cap, instead of the scene's.
+    pub iterations: Option<u32>,
+    /// Keep stretch springs on constrained edges.
+    pub stretch_springs: bool,
+    /// Take the constraint direction at the start of the step.
+    pub start_of_step: bool,
+    /// Whether to count edge crossings at every step end.
+    pub check_crossings: bool,
+    /// Turn collisions off.
+    pub no_collisions: bool,
+    /// Strands of the scale scenario, instead of the scene's.
+    pub strands: Option<usize>,
+    /// Particles per strand of the scale scenario, instead of the scene's.
+    pub particles: Option<usize>,
+    /// Write an animated GIF here.
+    pub gif: Option<PathBuf>,
+    /// Write numbered PNG frames into this directory.
+    pub frames: Option<PathBuf>,
+    /// Write the length-error plot (PNG) here.
+    pub plot: Option<PathBuf>,
+    /// Frame size and rate of `gif` and `frames`.
+    pub frame_settings: FrameSettings,
+}
+
+/// Why a run could not start or finish.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// Pictures could not be written.
+    #[error(transparent)]
+    Export(#[from] ExportError),
+    /// The scenario is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// No built-in scenario has that name.
+    #[error("unknown scenario '{name}'; valid scenarios: {valid}")]
+    UnknownScenario {
+        /// The name given.
+        name: String,
+        /// The valid names.
+        valid: String,
+    },
+}
+
+/// The scenario the options describe, overrides applied and validated.
+pub fn load_scenario(options: &RunOptions) -> Result<Scenario, RunError> {
+    let mut scenario = match &options.scene_file {
+        Some(path) => Scenario::load(path)?,
+        None => builtin(&options.scenario)
+            .ok_or_else(|| RunError::UnknownScenario {
+                name: options.scenario.clone(),
+                valid: builtin_names().join(", "),
+            })?
+            .scenario()?,
+    };
+    let command_line = |item: &str, problem: String| {
+        RunError::Scenario(ScenarioError::new("command line", item, problem))
+    };
+    if let Some(seconds) = options.seconds {
+        scenario.duration = seconds;
+    }
+    if let Some(dt) = options.dt {
+        scenario.step.dt = dt;
+    }
+    if let Some(substeps) = options.substeps {
+        scenario.step.substeps = substeps;
+    }
+    if let Some(solver) = &options.solver {
+        scenario.constraints.solver = solver.parse().map_err(|e| command_line("--solver", e))?;
+    }
+    if let Some(iterations) = options.iterations {
+        scenario.constraints.max_iterations = iterations;
+    }
+    scenario.constraints.stretch_springs |= options.stretch_springs;
+    if options.start_of_step {
+        scenario.constraints.direction = ConstraintDirection::StartOfStep;
+    }
+    if options.no_collisions {
+        scenario.collisions.enabled = false;
+    }
+    scenario.collisions.check_crossings = options.check_crossings;
+    if options.strands.is_some() || options.particles.is_some() {
+        let Some(scale) = &mut scenario.scale else {
+            return Err(command_line(
+                "--strands/--particles",
+                format!(
+                    "only the scale scenario has them; {} has no scale section",
+                    scenario.name
+                ),
+            ));
+        };
+        scale.strands = options.strands.unwrap_or(scale.strands);
+        scale.particles = options.particles.unwrap_or(scale.particles);
+    }
+    scenario.validate("command line")?;
+    Ok(scenario)
+}
+
+/// An app with the simulation driven by hand, the scenario logic, and the scenario
+/// spawned.
+pub fn headless_app(scenario: &Scenario) -> Result<App, RunError> {
+    let mut app = App::new();
+    app.add_plugins((StrandsPlugin::manual(), ScenesPlugin));
+    app.finish();
+    app.cleanup();
+    spawn_scenario(app.world_mut(), scenario)?;
+    Ok(app)
+}
+
+/// Run the scene for its duration and report. `progress` is told the fraction done
+/// after every tick.
+pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report, RunError> {
+    let scene = load_scenario(options)?;
+    let mut app = headless_app(&scene)?;
+    let world = app.world_mut();
+    if options.check_crossings {
+        world.resource_mut::<StrandMetrics>().edge_crossings = Some(0);
+    }
+    if options.plot.is_some() {
+        world.init_resource::<LengthErrorHistory>();
+    }
+    let mut recorder = if options.gif.is_some() || options.frames.is_some() {
+        Some(Recorder::new(
+            options.frame_settings,
+            scene.view(),
+            &scene.name,
+            options.gif.as_deref(),
+            options.frames.as_deref(),
+        )?)
+    } else {
+        None
+    };
+
+    let total_steps = (scene.duration / scene.step.dt).round().max(1.0) as u64;
+    let mut particle_steps = 0u64;
+    // The ticks alone: drawing and writing pictures is not the simulation's cost.
+    let mut wall_seconds = 0.0;
+    loop {
+        let steps = world.resource::<SimulationClock>().steps;
+        if steps >= total_steps {
+            break;
+        }
+        let substeps = (total_steps - steps).min(scene.step.substeps as u64) as u32;
+        world.resource_mut::<StrandsConfig>().substeps = substeps;
+        let tick_start = Instant::now();
+        world.run_schedule(StrandsTick);
+        wall_seconds += tick_start.elapsed().as_secs_f64();
+        particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
+        progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
+        if let Some(recorder) = &mut recorder {
+            recorder.capture_if_due(world)?;
+        }
+    }
+    let mut report = report(world, &scene, wall_seconds, particle_steps);
+    if let Some(recorder) = recorder {
+        let frames = recorder.finish()?;
+        for (kind, path) in [("GIF", &options.gif), ("PNG frames", &options.frames)] {
+            if let Some(path) = path {
+                report
+                    .pictures
+                    .push(format!("{kind}: {} ({frames} frames)", path.display()));
+            }
+        }
+    }
+    if let Some(path) = &options.plot {
+        let history = world.resource::<LengthErrorHistory>();
+        plot_length_error(path, &scene.name, &history.samples, (900, 500))?;
+        report.pictures.push(format!("plot: {}", path.display()));
+    }
+    Ok(report)
+}
+
+fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u64) -> Report {
+    let metrics = world.resource::<StrandMetrics>();
+    let clock = world.resource::<SimulationClock>();
+    let solver = world.resource::<ConstraintConfig>().solver;
+    let islands = world.resource::<Islands>();
+    let island_report = IslandReport {
+        path: islands.count(IslandKind::Path),
+        cycle: islands.count(IslandKind::Cycle),
+        tree: islands.count(IslandKind::Tree),
+        graph: islands.count(IslandKind::Graph),
+        unsolved: islands.unsolved.len(),
+        solvers: [
+            IslandKind::Path,
+            IslandKind::Cycle,
+            IslandKind::Tree,
+            IslandKind::Graph,
+        ]
+        .into_iter()
+        .filter(|&kind| islands.count(kind) > 0)
+        .map(|kind| {
+            let method = solver.method(kind).unwrap_or("none: stretch springs");
+            format!("{}: {method}", kind.name())
+        })
+        .collect(),
+    };
+    let mut notes = Vec::new();
+    if solver == SolverKind::Springs {
+        notes.push(
+            "solver springs: no constraints; every edge is a stretch spring, so lengths \
+             follow the spring stiffness"
+                .to_string(),
+        );
+    }
+    if solver.relaxation().is_some() {
+        let sweeps = world.resource::<ConstraintConfig>().max_iterations;
+        notes.push(format!(
+            "solver {solver}: a relaxation baseline, {sweeps} sweeps per step at most; \
+             contacts are left to the collision impulses, not fed back into the solve"
+        ));
+    }
+    if !world.resource::<CollisionConfig>().enabled {
+        notes.push(
+            "collisions are off in this run: edges may pass through each other, and \
+             edge_crossings counts the steps at which some did"
+                .to_string(),
+        );
+    }
+    if metrics.edge_crossings.is_none() {
+        notes.push("edge crossings were not checked (--no-check)".to_string());
+    }
+    if metrics.unresolved_collisions > 0 {
+        notes.push(format!(
+            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other)",
+            metrics.unresolved_collisions
+        ));
+    }
+    let input_problems = world
+        .resource::<InputProblems>()
+        .entries
+        .iter()
+        .map(|p| format!("{}: {}", p.entity, p.problem))
+        .collect();
+    Report {
+        scenario: scene.name.clone(),
+        config: serde_json::to_value(scene).expect("a scenario always serializes"),
+        solver: solver.name().to_string(),
+        steps: clock.steps,
+        sim_time: clock.time,
+        particles: metrics.particles,
+        strands: metrics.strands,
+        constrained_edges: metrics.constrained_edges,
+        islands: island_report,
+        max_rel_length_error: metrics.max_rel_length_error,
+        max_rel_length_error_free: metrics.max_rel_length_error_free,
+        edge_crossings: metrics.edge_crossings,
+        collisions: metrics.collisions,
+        failsafe_steps: metrics.failsafe_steps,
+        projection_iterations_mean: metrics.projection.mean(),
+        projection_iterations_max: metrics.projection.max,
+        projection_capped_solves: metrics.projection.capped,
+        contact_projection_solves: metrics.contact_projection.solves,
+        contact_projection_iterations_mean: metrics.contact_projection.mean(),
+        contact_projection_iterations_max: metrics.contact_projection.max,
+        contact_projection_capped_solves: metrics.contact_projection.capped,
+        contact_projection_rejected_solves: metrics.contact_projection.rejected,
+        contact_unsettled_steps: metrics.contact_unsettled_steps,
+        wall_seconds,
+        particle_steps_per_second: if wall_seconds > 0.0 {
+            particle_steps as f64 / wall_seconds
+        } else {
+            0.0
+        },
+        notes,
+        input_problems,
+        pictures: Vec::new(),
+    }
+}

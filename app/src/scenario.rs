@@ -1,0 +1,624 @@
+//! Scenario files: a scenario's settings and what it spawns, as a human-readable RON
+//! file, validated on load before anything is spawned.
+//!
+//! The settings are the library's own configuration resources (`step`, `constraints`,
+//! `collisions`, `contact`), each field defaulting to the library's default; what to
+//! spawn is described by the spec types below. A file that cannot be simulated is
+//! refused with an error naming the file, the item and the problem.
+
+use std::path::Path;
+
+use bevy::math::DVec2;
+use bevy_strands::model::validate::{
+    NumberError, at_least, check_particle, finite, finite_vector, non_negative, positive,
+};
+use bevy_strands::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::export::raster::View;
+
+/// A problem with a scenario file: which file, which item in it, and what is wrong.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("{file}: {item}: {problem}")]
+pub struct ScenarioError {
+    /// The file (or the built-in scenario's name).
+    pub file: String,
+    /// The item in the file, e.g. `strands[2].shape.spacing`.
+    pub item: String,
+    /// What is wrong with it.
+    pub problem: String,
+}
+
+impl ScenarioError {
+    /// A problem with `item` of `file`.
+    pub fn new(file: &str, item: impl Into<String>, problem: impl Into<String>) -> Self {
+        Self {
+            file: file.to_string(),
+            item: item.into(),
+            problem: problem.into(),
+        }
+    }
+
+    fn number(file: &str, prefix: &str, e: NumberError) -> Self {
+        let item = if prefix.is_empty() {
+            e.field
+        } else {
+            format!("{prefix}.{}", e.field)
+        };
+        Self::new(file, item, e.problem)
+    }
+}
+
+/// A scenario: the settings, how long it runs, and what to spawn.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Scenario name.
+    pub name: String,
+    /// One line on what the scenario shows.
+    #[serde(default)]
+    pub description: String,
+    /// Simulated seconds a run covers.
+    pub duration: f64,
+    /// The step, gravity, damping and the default material.
+    #[serde(default)]
+    pub step: StrandsConfig,
+    /// The constraint solver.
+    #[serde(default)]
+    pub constraints: ConstraintConfig,
+    /// Collisions.
+    #[serde(default)]
+    pub collisions: CollisionConfig,
+    /// The contact loop.
+    #[serde(default)]
+    pub contact: ContactConfig,
+    /// An axis-aligned box of pinned walls.
+    #[serde(default)]
+    pub container: Option<ContainerSpec>,
+    /// Strands.
+    #[serde(default)]
+    pub strands: Vec<StrandSpec>,
+    /// Loose particles.
+    #[serde(default)]
+    pub particles: Vec<ParticleSpec>,
+    /// Edges joining particles of the strands above: branches (trees), rungs and
+    /// cross-links (graphs).
+    #[serde(default)]
+    pub links: Vec<LinkSpec>,
+    /// A spaghetti factory.
+    #[serde(default)]
+    pub spaghetti_factory: Option<SpaghettiFactorySpec>,
+    /// A meatball factory.
+    #[serde(default)]
+    pub meatball_factory: Option<MeatballFactorySpec>,
+    /// A furry creature.
+    #[serde(default)]
+    pub furry_creature: Option<FurryCreatureSpec>,
+    /// A throughput test: many strands dropped into a box sized for them (replaces
+    /// `container`).
+    #[serde(default)]
+    pub scale: Option<ScaleSpec>,
+}
+
+/// The meatball factory (see [`MeatballFactory`](crate::scenes::meatball_factory::MeatballFactory)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeatballFactorySpec {
+    /// Seconds between drops.
+    pub interval: f64,
+    /// Simulated time of the first drop.
+    #[serde(default)]
+    pub start: f64,
+    /// Side of the triangles.
+    pub side: f64,
+    /// Height the triangles' centres are dropped from.
+    pub height: f64,
+    /// x of the first drop.
+    pub first_x: f64,
+    /// x step between drops.
+    pub step_x: f64,
+    /// Drops past this x wrap around by whole steps...
+    pub wrap_x: f64,
+    /// ...to the lowest drop point at or above this x.
+    pub low_x: f64,
+    /// Initial falling speed.
+    pub speed: f64,
+    /// Spin (rad/s), alternating in sign from drop to drop.
+    pub spin: f64,
+    /// Triangles at most.
+    pub max: usize,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+/// The furry creature (see [`FurryCreature`](crate::scenes::furry_creature::FurryCreature)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FurryCreatureSpec {
+    /// Centre of the body's circular path.
+    pub centre: [f64; 2],
+    /// Radius of the path.
+    pub path_radius: f64,
+    /// Seconds per turn of the path.
+    pub period: f64,
+    /// Radius of the body.
+    pub body_radius: f64,
+    /// Hairs, evenly spaced around the rim.
+    pub hairs: usize,
+    /// Particles per hair.
+    pub particles_per_hair: usize,
+    /// Rest spacing of the hairs' particles.
+    pub spacing: f64,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+/// The scale scenario's strands.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleSpec {
+    /// Strands.
+    pub strands: usize,
+    /// Particles per strand.
+    pub particles: usize,
+    /// Rest spacing.
+    pub spacing: f64,
+}
+
+/// The spaghetti factory (see [`SpaghettiFactory`](crate::scenes::spaghetti_factory::SpaghettiFactory)).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpaghettiFactorySpec {
+    /// Where particles appear.
+    pub inlet: [f64; 2],
+    /// Their velocity there.
+    pub velocity: [f64; 2],
+    /// Seconds between particles.
+    pub interval: f64,
+    /// Particles per strand.
+    pub particles_per_strand: usize,
+    /// Newest particles held at the inlet velocity.
+    #[serde(default = "two")]
+    pub held: usize,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Stop after this many strands.
+    #[serde(default)]
+    pub max_strands: Option<usize>,
+}
+
+fn two() -> usize {
+    2
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Walls: a closed loop of four pinned particles at the corners of a box.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContainerSpec {
+    /// Lower-left corner.
+    pub min: [f64; 2],
+    /// Upper-right corner.
+    pub max: [f64; 2],
+}
+
+/// The shape a strand starts in.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// A straight open strand from `start` at `angle_degrees` from the +x axis.
+    Line {
+        /// First particle.
+        start: [f64; 2],
+        /// Direction, degrees counter-clockwise from +x.
+        angle_degrees: f64,
+        /// Particle count.
+        particles: usize,
+        /// Rest spacing.
+        spacing: f64,
+    },
+    /// An open strand through the points.
+    Polyline {
+        /// The particles' positions.
+        points: Vec<[f64; 2]>,
+    },
+    /// A closed loop through the points, keeping their shape at rest.
+    Polygon {
+        /// The particles' positions.
+        points: Vec<[f64; 2]>,
+    },
+}
+
+/// A strand in a scenario file.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StrandSpec {
+    /// Initial shape.
+    pub shape: ShapeSpec,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Initial velocity of each particle.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Indices of pinned particles.
+    #[serde(default)]
+    pub pinned: Vec<usize>,
+    /// Rest lengths, when not the initial distances.
+    #[serde(default)]
+    pub rest_lengths: Option<Vec<f64>>,
+    /// What it represents.
+    #[serde(default)]
+    pub kind: StrandKind,
+    /// Material, when not the scenario's default.
+    #[serde(default)]
+    pub material: Option<StrandMaterial>,
+}
+
+/// An edge between two particles of `strands`, each named `(strand, particle)` by
+/// index; its rest length is their initial distance.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct LinkSpec {
+    /// One end: (strand index, particle index).
+    pub from: (usize, usize),
+    /// The other end.
+    pub to: (usize, usize),
+}
+
+/// A particle on its own.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    /// Position.
+    pub position: [f64; 2],
+    /// Velocity.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Mass.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Pinned.
+    #[serde(default)]
+    pub pinned: bool,
+}
+
+pub(crate) fn vec2(v: [f64; 2]) -> DVec2 {
+    DVec2::new(v[0], v[1])
+}
+
+impl StrandSpec {
+    /// The builder this spec describes (not yet validated).
+    pub fn builder(&self) -> StrandBuilder {
+        let builder = match &self.shape {
+            ShapeSpec::Line {
+                start,
+                angle_degrees,
+                particles,
+                spacing,
+            } => {
+                let direction = DVec2::from_angle(angle_degrees.to_radians());
+                StrandBuilder::line(vec2(*start), direction, *particles, *spacing)
+            }
+            ShapeSpec::Polyline { points } => {
+                StrandBuilder::polyline(points.iter().map(|&p| vec2(p)))
+            }
+            ShapeSpec::Polygon { points } => {
+                StrandBuilder::closed_loop(points.iter().map(|&p| vec2(p)))
+            }
+        };
+        let mut builder = builder
+            .mass(self.mass)
+            .velocity(vec2(self.velocity))
+            .kind(self.kind);
+        for &i in &self.pinned {
+            builder = builder.pin(i);
+        }
+        if let Some(lengths) = &self.rest_lengths {
+            builder = builder.rest_lengths(lengths.clone());
+        }
+        if let Some(material) = self.material {
+            builder = builder.material(material);
+        }
+        builder
+    }
+
+    /// Validate: the spec's own numbers, then the builder's rules. On failure, the
+    /// field (with a leading `.`, or empty for the strand as a whole) and the problem.
+    fn validate(&self) -> Result<(), (String, String)> {
+        let at = |e: NumberError| (format!(".{}", e.field), e.problem);
+        match &self.shape {
+            ShapeSpec::Line {
+                start,
+                angle_degrees,
+                particles,
+                spacing,
+            } => {
+                finite_vector("shape.start", vec2(*start)).map_err(at)?;
+                finite("shape.angle_degrees", *angle_degrees).map_err(at)?;
+                at_least("shape.particles", *particles, 2, "a strand").map_err(at)?;
+                if !(spacing.is_finite() && *spacing > 0.0) {
+                    return Err((
+                        ".shape.spacing".into(),
+                        format!(
+                            "{spacing} would make a zero or negative rest length; it must be positive"
+                        ),
+                    ));
+                }
+            }
+            ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => {
+                for (j, &p) in points.iter().enumerate() {
+                    finite_vector(&format!("shape.points[{j}]"), vec2(p)).map_err(at)?;
+                }
+            }
+        }
+        if let Some(material) = &self.material {
+            material.validate().map_err(|e| at(e.within("material")))?;
+        }
+        finite_vector("velocity", vec2(self.velocity)).map_err(at)?;
+        positive("mass", self.mass).map_err(at)?;
+        self.builder()
+            .validate()
+            .map(|_| ())
+            .map_err(|e| (String::new(), e.to_string()))
+    }
+}
+
+impl Scenario {
+    /// Parse and validate a scenario from RON text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Scenario, ScenarioError> {
+        let scenario: Scenario = ron::from_str(text).map_err(|e| {
+            ScenarioError::new(
+                file,
+                format!("line {}, column {}", e.span.start.line, e.span.start.col),
+                e.code.to_string(),
+            )
+        })?;
+        scenario.validate(file)?;
+        Ok(scenario)
+    }
+
+    /// Read, parse and validate a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ScenarioError::new(&file, "file", e.to_string()))?;
+        Self::parse(&text, &file)
+    }
+
+    /// The rectangle pictures show: the container (the scale scenario's included), or
+    /// the unit box.
+    pub fn view(&self) -> View {
+        let container = self.scale.map(|s| s.container()).or(self.container);
+        match container {
+            Some(c) => View {
+                min: vec2(c.min),
+                max: vec2(c.max),
+            },
+            None => View {
+                min: DVec2::ZERO,
+                max: DVec2::ONE,
+            },
+        }
+    }
+
+    /// Check every number and every item; the first problem found is returned.
+    pub fn validate(&self, file: &str) -> Result<(), ScenarioError> {
+        let fail = |item: &str, problem: String| ScenarioError::new(file, item, problem);
+        let number = |prefix: &'static str| move |e| ScenarioError::number(file, prefix, e);
+        if self.name.trim().is_empty() {
+            return Err(fail("name", "must not be empty".into()));
+        }
+        positive("duration", self.duration).map_err(number(""))?;
+        self.step.validate().map_err(number("step"))?;
+        self.constraints.validate().map_err(number("constraints"))?;
+        self.collisions.validate().map_err(number("collisions"))?;
+        self.contact.validate().map_err(number("contact"))?;
+        if let Some(container) = &self.container {
+            finite_vector("min", vec2(container.min)).map_err(number("container"))?;
+            finite_vector("max", vec2(container.max)).map_err(number("container"))?;
+            if !(container.min[0] < container.max[0] && container.min[1] < container.max[1]) {
+                return Err(fail(
+                    "container",
+                    format!(
+                        "min {:?} must be below and left of max {:?}",
+                        container.min, container.max
+                    ),
+                ));
+            }
+        }
+        for (i, strand) in self.strands.iter().enumerate() {
+            let item = format!("strands[{i}]");
+            strand
+                .validate()
+                .map_err(|(field, p)| fail(&format!("{item}{field}"), p))?;
+        }
+        self.validate_links().map_err(|(item, p)| fail(&item, p))?;
+        if let Some(f) = &self.spaghetti_factory {
+            let at = number("spaghetti_factory");
+            finite_vector("inlet", vec2(f.inlet)).map_err(at)?;
+            finite_vector("velocity", vec2(f.velocity)).map_err(at)?;
+            positive("interval", f.interval).map_err(at)?;
+            positive("mass", f.mass).map_err(at)?;
+            if f.velocity[0] == 0.0 && f.velocity[1] == 0.0 {
+                return Err(fail(
+                    "spaghetti_factory.velocity",
+                    "must not be zero: it sets the strands' rest spacing".into(),
+                ));
+            }
+            at_least(
+                "particles_per_strand",
+                f.particles_per_strand,
+                2,
+                "a strand",
+            )
+            .map_err(at)?;
+        }
+        if let Some(m) = &self.meatball_factory {
+            let at = number("meatball_factory");
+            for (field, value) in [
+                ("interval", m.interval),
+                ("side", m.side),
+                ("step_x", m.step_x),
+                ("mass", m.mass),
+            ] {
+                positive(field, value).map_err(at)?;
+            }
+            for (field, value) in [
+                ("start", m.start),
+                ("height", m.height),
+                ("first_x", m.first_x),
+                ("wrap_x", m.wrap_x),
+                ("low_x", m.low_x),
+                ("speed", m.speed),
+                ("spin", m.spin),
+            ] {
+                finite(field, value).map_err(at)?;
+            }
+        }
+        if let Some(f) = &self.furry_creature {
+            let at = number("furry_creature");
+            finite_vector("centre", vec2(f.centre)).map_err(at)?;
+            for (field, value) in [
+                ("period", f.period),
+                ("body_radius", f.body_radius),
+                ("spacing", f.spacing),
+                ("mass", f.mass),
+            ] {
+                positive(field, value).map_err(at)?;
+            }
+            non_negative("path_radius", f.path_radius).map_err(at)?;
+            at_least(
+                "particles_per_hair",
+                f.particles_per_hair,
+                3,
+                "a hair (two are its root)",
+            )
+            .map_err(at)?;
+        }
+        if let Some(scale) = &self.scale {
+            let at = number("scale");
+            positive("spacing", scale.spacing).map_err(at)?;
+            at_least("strands", scale.strands, 1, "a scale run").map_err(at)?;
+            at_least("particles", scale.particles, 2, "a strand").map_err(at)?;
+        }
+        for (i, particle) in self.particles.iter().enumerate() {
+            let item = format!("particles[{i}]");
+            let (position, velocity) = (vec2(particle.position), vec2(particle.velocity));
+            check_particle(position, velocity, particle.mass, particle.pinned)
+                .map_err(|e| fail(&format!("{item}.{}", e.field()), e.to_string()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Scenario {
+    /// Every link names two different, existing, separate particles, once.
+    fn validate_links(&self) -> Result<(), (String, String)> {
+        if self.links.is_empty() {
+            return Ok(());
+        }
+        let points: Vec<Vec<DVec2>> = self
+            .strands
+            .iter()
+            .map(|s| s.builder().points().to_vec())
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        for (i, link) in self.links.iter().enumerate() {
+            let item = format!("links[{i}]");
+            let mut ends = [DVec2::ZERO; 2];
+            for (end, (field, (strand, particle))) in
+                ends.iter_mut().zip([("from", link.from), ("to", link.to)])
+            {
+                let Some(strand_points) = points.get(strand) else {
+                    return Err((
+                        format!("{item}.{field}"),
+                        format!(
+                            "strand {strand} does not exist; the scene has {} strands",
+                            points.len()
+                        ),
+                    ));
+                };
+                *end = *strand_points.get(particle).ok_or_else(|| {
+                    (
+                        format!("{item}.{field}"),
+                        format!(
+                            "strand {strand} has no particle {particle}; it has {}",
+                            strand_points.len()
+                        ),
+                    )
+                })?;
+            }
+            if link.from == link.to {
+                return Err((item, "an edge needs two different particles".into()));
+            }
+            if ends[0].distance(ends[1]) <= 0.0 {
+                return Err((
+                    item,
+                    format!(
+                        "its particles coincide at {:?}: a zero rest length",
+                        ends[0]
+                    ),
+                ));
+            }
+            let key = (link.from.min(link.to), link.from.max(link.to));
+            if !seen.insert(key) {
+                return Err((
+                    item,
+                    "joins the same two particles as an earlier link".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl ScaleSpec {
+    /// Strands per row of the initial arrangement.
+    pub fn columns(&self) -> usize {
+        ((self.strands as f64 / 8.0).sqrt().ceil() as usize).max(1)
+    }
+
+    /// Length of one strand.
+    pub fn strand_length(&self) -> f64 {
+        (self.particles - 1) as f64 * self.spacing
+    }
+
+    /// Horizontal and vertical pitch of the arrangement.
+    pub fn pitch(&self) -> DVec2 {
+        DVec2::new(
+            self.strand_length() + 5.0 * self.spacing,
+            4.0 * self.spacing,
+        )
+    }
+
+    /// The box the strands start in and fall into.
+    pub fn container(&self) -> ContainerSpec {
+        let rows = self.strands.div_ceil(self.columns());
+        let pitch = self.pitch();
+        ContainerSpec {
+            min: [0.0, 0.0],
+            max: [
+                self.columns() as f64 * pitch.x + 2.0 * self.spacing,
+                (rows as f64 + 2.0) * pitch.y,
+            ],
+        }
+    }
+
+    /// First particle of strand `s`; strands run along +x.
+    pub fn start(&self, s: usize) -> DVec2 {
+        let (row, column) = (s / self.columns(), s % self.columns());
+        let pitch = self.pitch();
+        DVec2::new(
+            3.5 * self.spacing + column as f64 * pitch.x,
+            (row as f64 + 1.5) * pitch.y,
+        )
+    }
+}

@@ -1,0 +1,135 @@
+//! Spawning a validated scenario into a world.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_strands::prelude::*;
+use bevy_strands::world::edit::create_edge;
+
+use crate::scenario::{Scenario, ScenarioError, vec2};
+use crate::scenes::furry_creature::{FurryCreature, spawn_furry_creature};
+use crate::scenes::meatball_factory::MeatballFactory;
+use crate::scenes::spaghetti_factory::SpaghettiFactory;
+
+/// Configure the world's resources from the scenario and spawn its walls, strands and
+/// particles. The scenario must have passed [`Scenario::validate`].
+pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), ScenarioError> {
+    let fail = |item: String, problem: String| ScenarioError::new(&scene.name, item, problem);
+    world.insert_resource(scene.step.clone());
+    world.insert_resource(scene.constraints.clone());
+    world.insert_resource(scene.collisions.clone());
+    world.insert_resource(scene.contact.clone());
+
+    if let Some(scale) = &scene.scale {
+        let container = scale.container();
+        container_builder(vec2(container.min), vec2(container.max))
+            .spawn_in(world)
+            .map_err(|e| fail("scale".into(), e.to_string()))?;
+        let step = DVec2::new(scale.spacing, 0.0);
+        for s in 0..scale.strands {
+            let start = scale.start(s);
+            // A gentle wave so that strands do not land perfectly flat on each other.
+            let points = (0..scale.particles).map(|i| {
+                let wave = 0.5 * scale.spacing * ((i + 3 * s) as f64 * 0.4).sin();
+                start + step * i as f64 + DVec2::new(0.0, wave)
+            });
+            StrandBuilder::polyline(points)
+                .kind(StrandKind::Rope)
+                .spawn_in(world)
+                .map_err(|e| fail(format!("scale strand {s}"), e.to_string()))?;
+        }
+    } else if let Some(container) = &scene.container {
+        container_builder(vec2(container.min), vec2(container.max))
+            .spawn_in(world)
+            .map_err(|e| fail("container".into(), e.to_string()))?;
+    }
+    let mut strands = Vec::with_capacity(scene.strands.len());
+    for (i, strand) in scene.strands.iter().enumerate() {
+        let entity = strand
+            .builder()
+            .spawn_in(world)
+            .map_err(|e| fail(format!("strands[{i}]"), e.to_string()))?;
+        strands.push(entity);
+    }
+    for (i, link) in scene.links.iter().enumerate() {
+        let particle = |(strand, particle): (usize, usize)| {
+            strands
+                .get(strand)
+                .and_then(|&s| world.get::<Strand>(s))
+                .and_then(|s| s.particles.get(particle).copied())
+                .ok_or_else(|| {
+                    fail(
+                        format!("links[{i}]"),
+                        format!("no particle {particle} in strand {strand}"),
+                    )
+                })
+        };
+        let (a, b) = (particle(link.from)?, particle(link.to)?);
+        create_edge(world, a, b).map_err(|e| fail(format!("links[{i}]"), e.to_string()))?;
+    }
+    if let Some(f) = &scene.spaghetti_factory {
+        let mut factory = SpaghettiFactory::new(
+            vec2(f.inlet),
+            vec2(f.velocity),
+            f.interval,
+            f.particles_per_strand,
+        );
+        factory.held = f.held;
+        factory.mass = f.mass;
+        factory.max_strands = f.max_strands;
+        world.spawn(factory);
+    }
+    if let Some(m) = &scene.meatball_factory {
+        world.spawn(MeatballFactory {
+            interval: m.interval,
+            side: m.side,
+            height: m.height,
+            drop_x: m.first_x,
+            step_x: m.step_x,
+            wrap_x: m.wrap_x,
+            low_x: m.low_x,
+            speed: m.speed,
+            spin: m.spin,
+            max: m.max,
+            mass: m.mass,
+            next_drop: m.start,
+            dropped: 0,
+            skipped: 0,
+        });
+    }
+    if let Some(f) = &scene.furry_creature {
+        let creature = FurryCreature::new(vec2(f.centre), f.path_radius, f.period, f.body_radius);
+        spawn_furry_creature(
+            world,
+            creature,
+            f.hairs,
+            f.particles_per_hair,
+            f.spacing,
+            f.mass,
+        );
+    }
+    for particle in &scene.particles {
+        let mut entity = world.spawn((
+            Particle,
+            Position(vec2(particle.position)),
+            Velocity(vec2(particle.velocity)),
+            Mass(particle.mass),
+        ));
+        if particle.pinned {
+            entity.insert(Pinned);
+        }
+    }
+    Ok(())
+}
+
+/// The walls of an axis-aligned box: a closed loop of four pinned particles, with no
+/// springs or bending (its edges are static obstacles).
+pub fn container_builder(min: DVec2, max: DVec2) -> StrandBuilder {
+    let corners = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)];
+    let mut builder = StrandBuilder::closed_loop(corners)
+        .kind(StrandKind::Wall)
+        .material(StrandMaterial::INERT);
+    for i in 0..4 {
+        builder = builder.pin(i);
+    }
+    builder
+}

@@ -1,0 +1,99 @@
+//! The windowed demos (feature `render`): the scene drawn with the library's gizmo
+//! drawing, a camera that keeps it in view beside an egui panel with controls and live
+//! figures, mouse tools, keyboard shortcuts, frame export and an opt-in screenshot for
+//! scripted checks.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use bevy_strands::prelude::*;
+//! use bevy_strands_app::window::{ActiveScenario, DemoPlugins, window_plugins};
+//!
+//! App::new()
+//!     .add_plugins(window_plugins("long strand"))
+//!     .add_plugins((StrandsPlugin::default(), DemoPlugins))
+//!     .insert_resource(ActiveScenario::builtin("long_strand").expect("a built-in scenario"))
+//!     .run();
+//! ```
+
+mod layout;
+mod screenshot;
+mod tools;
+mod ui;
+mod view;
+
+use bevy::app::PluginGroupBuilder;
+use bevy::prelude::*;
+use bevy::window::WindowResolution;
+use bevy_strands::render::StrandsDebugDrawPlugin;
+
+use crate::scenario::{Scenario, ScenarioError};
+use crate::scenes::{ScenesPlugin, builtin, builtin_names};
+use crate::spawn::spawn_scenario;
+
+pub use layout::UiLayout;
+pub use screenshot::ScreenshotPlugin;
+pub use tools::{Tool, ToolState};
+pub use ui::StrandsUiPlugin;
+pub use view::DemoViewPlugin;
+
+/// Bevy's default plugins for an example window: 1280×720, titled.
+pub fn window_plugins(title: &str) -> PluginGroupBuilder {
+    DefaultPlugins.set(WindowPlugin {
+        primary_window: Some(Window {
+            title: format!("bevy_strands: {title}"),
+            resolution: WindowResolution::new(1280, 720),
+            ..default()
+        }),
+        ..default()
+    })
+}
+
+/// Everything a demo window adds to the simulation: the scenario logic, the strands'
+/// debug drawing, the demo's camera and bodies, and the panel with its tools.
+pub struct DemoPlugins;
+
+impl PluginGroup for DemoPlugins {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>()
+            .add(ScenesPlugin)
+            .add(StrandsDebugDrawPlugin)
+            .add(DemoViewPlugin)
+            .add(StrandsUiPlugin)
+    }
+}
+
+/// The scenario shown: spawned at start-up and again on reset.
+#[derive(Resource, Clone, Debug)]
+pub struct ActiveScenario {
+    /// The scenario.
+    pub scenario: Scenario,
+}
+
+impl ActiveScenario {
+    /// A built-in scenario (see `strands list`).
+    pub fn builtin(name: &str) -> Result<Self, ScenarioError> {
+        let scene = builtin(name).ok_or_else(|| {
+            ScenarioError::new(
+                name,
+                "name",
+                format!(
+                    "no built-in scenario of that name; valid: {}",
+                    builtin_names().join(", ")
+                ),
+            )
+        })?;
+        Ok(Self {
+            scenario: scene.scenario()?,
+        })
+    }
+}
+
+/// Spawn the active scenario (start-up, reset).
+pub fn spawn_active_scenario(world: &mut World) {
+    let Some(active) = world.get_resource::<ActiveScenario>().cloned() else {
+        return;
+    };
+    if let Err(e) = spawn_scenario(world, &active.scenario) {
+        error!("bevy_strands: {e}");
+    }
+}

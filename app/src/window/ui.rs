@@ -1,0 +1,406 @@
+//! The egui panel (run, pause, step, reset; the step, forces, solver and collision
+//! settings; live figures and a plot of the length error), keyboard shortcuts, reset
+//! and frame export.
+
+use std::ops::DerefMut;
+use std::path::PathBuf;
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use bevy_egui::{EguiContexts, EguiPlugin, EguiPrimaryContextPass, egui};
+use egui_plot::{Line, Plot, PlotPoints};
+
+use bevy_strands::metrics::LengthErrorHistory;
+use bevy_strands::prelude::*;
+use bevy_strands::render::DrawSettings;
+use bevy_strands::world::clock::StepTiming;
+
+use super::layout::UiLayout;
+use super::screenshot::ScreenshotPlugin;
+use super::tools::{Tool, ToolState, use_tools};
+use super::{ActiveScenario, spawn_active_scenario};
+use crate::export::{FrameSettings, Recorder};
+use crate::scenes::furry_creature::FurryCreature;
+use crate::scenes::meatball_factory::MeatballFactory;
+use crate::scenes::spaghetti_factory::SpaghettiFactory;
+
+/// PNG frames written while recording (the E key).
+#[derive(Resource, Default)]
+pub struct FrameExport {
+    recorder: Option<Recorder>,
+    /// Where frames go.
+    pub directory: PathBuf,
+    /// The last export error, shown in the panel.
+    pub message: Option<String>,
+}
+
+/// Samples of the error plot kept: older ones are dropped.
+const PLOT_SAMPLES: usize = 20_000;
+
+/// The panel, the mouse tools, the shortcuts, frame export and the opt-in screenshot.
+pub struct StrandsUiPlugin;
+
+impl Plugin for StrandsUiPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<EguiPlugin>() {
+            app.add_plugins(EguiPlugin::default());
+        }
+        app.init_resource::<ToolState>()
+            .init_resource::<UiLayout>()
+            .init_resource::<LengthErrorHistory>()
+            .insert_resource(FrameExport {
+                directory: PathBuf::from("frames"),
+                ..default()
+            })
+            .add_plugins(ScreenshotPlugin)
+            .add_systems(EguiPrimaryContextPass, panel)
+            .add_systems(Update, (shortcuts, use_tools, trim_history))
+            .add_systems(PostUpdate, export_frames);
+    }
+}
+
+/// The settings the panel edits.
+#[derive(SystemParam)]
+struct Settings<'w> {
+    step: ResMut<'w, StrandsConfig>,
+    constraints: ResMut<'w, ConstraintConfig>,
+    collisions: ResMut<'w, CollisionConfig>,
+    draw: ResMut<'w, DrawSettings>,
+}
+
+/// The figures the panel shows.
+#[derive(SystemParam)]
+struct Figures<'w> {
+    metrics: Res<'w, StrandMetrics>,
+    clock: Res<'w, SimulationClock>,
+    history: Res<'w, LengthErrorHistory>,
+    timing: Res<'w, StepTiming>,
+    problems: Res<'w, InputProblems>,
+    active: Option<Res<'w, ActiveScenario>>,
+    export: Res<'w, FrameExport>,
+}
+
+/// Edit a copy and write it back only if it changed, so that a frame in which nothing
+/// was touched does not look like a configuration change (which rebuilds caches).
+fn edit<T: Clone + PartialEq, R: DerefMut<Target = T>>(value: &mut R, change: impl FnOnce(&mut T)) {
+    let mut copy = T::clone(value);
+    change(&mut copy);
+    if copy != **value {
+        **value = copy;
+    }
+}
+
+fn panel(
+    mut contexts: EguiContexts,
+    mut settings: Settings,
+    figures: Figures,
+    mut tools: ResMut<ToolState>,
+    mut layout: ResMut<UiLayout>,
+    mut commands: Commands,
+) -> Result {
+    let ctx = contexts.ctx_mut()?;
+    let title = figures
+        .active
+        .as_ref()
+        .map_or("bevy_strands".to_string(), |a| {
+            format!("bevy_strands — {}", a.scenario.name)
+        });
+    let height = ctx.content_rect().height() - 60.0;
+    let response = egui::Window::new(title)
+        .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
+        // egui's default window height is 420: take the screen's instead.
+        .default_size([330.0, height])
+        .resizable(false)
+        .collapsible(true)
+        .vscroll(true)
+        .max_height(height)
+        .show(ctx, |ui| {
+            controls(ui, &mut settings, &mut commands);
+            ui.separator();
+            figures_ui(ui, &figures, &settings);
+            ui.separator();
+            tools_ui(ui, &mut tools);
+            ui.separator();
+            egui::CollapsingHeader::new("solver, collisions, drawing")
+                .default_open(true)
+                .show(ui, |ui| solver_ui(ui, &mut settings));
+        });
+    let panel = response.map(|r| r.response.rect);
+    layout.panel_width = panel.map_or(0.0, |r| ctx.content_rect().right() - r.left());
+    layout.panel_rect = panel.map(|r| Rect::new(r.left(), r.top(), r.right(), r.bottom()));
+    layout.pointer_busy = ctx.egui_is_using_pointer();
+    layout.keyboard_over_ui = ctx.egui_wants_keyboard_input();
+    Ok(())
+}
+
+fn controls(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands) {
+    ui.horizontal(|ui| {
+        let paused = settings.step.paused;
+        if ui
+            .button(if paused { "▶ run" } else { "⏸ pause" })
+            .clicked()
+        {
+            settings.step.paused = !paused;
+        }
+        if ui.button("step").on_hover_text("one tick").clicked() {
+            settings.step.paused = true;
+            commands.queue(|world: &mut World| world.run_schedule(StrandsTick));
+        }
+        if ui.button("reset").clicked() {
+            commands.queue(reset);
+        }
+    });
+    edit(&mut settings.step, |step| {
+        ui.horizontal(|ui| {
+            ui.label("dt");
+            ui.add(
+                egui::DragValue::new(&mut step.dt)
+                    .range(1e-5..=1e-1)
+                    .speed(1e-5)
+                    .custom_formatter(|v, _| format!("1/{:.0} s", 1.0 / v)),
+            );
+            ui.label("substeps");
+            ui.add(egui::DragValue::new(&mut step.substeps).range(1..=500));
+        });
+        ui.add(egui::Slider::new(&mut step.gravity.y, -30.0..=0.0).text("gravity y"));
+        ui.add(egui::Slider::new(&mut step.damping, 0.0..=5.0).text("damping"));
+    });
+}
+
+fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
+    let m = &figures.metrics;
+    let per_step_ms =
+        1000.0 * figures.timing.last_tick_seconds / settings.step.substeps.max(1) as f64;
+    egui::Grid::new("figures").num_columns(2).show(ui, |ui| {
+        let mut row = |name: &str, value: String| {
+            ui.label(name);
+            ui.monospace(value);
+            ui.end_row();
+        };
+        row(
+            "time",
+            format!(
+                "{:.2} s ({} steps)",
+                figures.clock.time, figures.clock.steps
+            ),
+        );
+        row(
+            "particles / strands",
+            format!("{} / {}", m.particles, m.strands),
+        );
+        row(
+            "edges (constrained)",
+            format!("{} ({})", m.edges, m.constrained_edges),
+        );
+        row(
+            "max |ℓ−L|/L now",
+            format!("{:.2e}", m.max_rel_length_error_now),
+        );
+        row(
+            "max |ℓ−L|/L ever",
+            format!("{:.2e}", m.max_rel_length_error),
+        );
+        row(
+            "… away from contact",
+            format!("{:.2e}", m.max_rel_length_error_free),
+        );
+        row(
+            "edge crossings",
+            m.edge_crossings
+                .map_or("not checked".into(), |c| c.to_string()),
+        );
+        row("impulses / step", format!("{}", m.collisions_last_step));
+        row("fail-safe steps", format!("{}", m.failsafe_steps));
+        row("ms / step", format!("{per_step_ms:.3}"));
+    });
+    // The length error over time, log scale.
+    let points: PlotPoints = figures
+        .history
+        .samples
+        .iter()
+        .map(|s| [s.time, s.all.max(1e-17).log10()])
+        .collect();
+    Plot::new("length_error")
+        .height(120.0)
+        .allow_scroll(false)
+        .allow_drag(false)
+        .y_axis_formatter(|mark, _| format!("1e{:.0}", mark.value))
+        .show(ui, |plot| plot.line(Line::new("max |ℓ−L|/L", points)));
+    if let Some(problem) = figures.problems.entries.last() {
+        ui.colored_label(
+            egui::Color32::LIGHT_RED,
+            format!("{}: {}", problem.entity, problem.problem),
+        );
+    }
+    if figures.export.recorder.is_some() {
+        ui.colored_label(
+            egui::Color32::LIGHT_GREEN,
+            format!("recording frames to {}", figures.export.directory.display()),
+        );
+    }
+    if let Some(message) = &figures.export.message {
+        ui.colored_label(egui::Color32::LIGHT_RED, message);
+    }
+}
+
+fn tools_ui(ui: &mut egui::Ui, tools: &mut ToolState) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("tool");
+        for tool in Tool::ALL {
+            ui.selectable_value(&mut tools.tool, tool, tool.label());
+        }
+    });
+    if tools.tool == Tool::Hair {
+        ui.add(egui::Slider::new(&mut tools.hair_spacing, 0.005..=0.05).text("hair spacing"));
+    }
+    if let Some(message) = &tools.message {
+        ui.colored_label(egui::Color32::LIGHT_RED, message);
+    }
+    ui.small("space run/pause · r reset · e record frames · = / − substeps");
+}
+
+fn solver_ui(ui: &mut egui::Ui, settings: &mut Settings) {
+    edit(&mut settings.constraints, |c| {
+        egui::ComboBox::from_label("solver")
+            .selected_text(c.solver.name())
+            .show_ui(ui, |ui| {
+                for kind in SolverKind::ALL {
+                    ui.selectable_value(&mut c.solver, kind, kind.name());
+                }
+            });
+        ui.add(
+            egui::Slider::new(&mut c.tolerance, 1e-14..=1e-3)
+                .logarithmic(true)
+                .custom_formatter(|v, _| format!("{v:.0e}"))
+                .text("tolerance"),
+        );
+        ui.add(egui::Slider::new(&mut c.max_iterations, 1..=50).text("iteration cap"));
+    });
+    edit(&mut settings.collisions, |c| {
+        ui.checkbox(&mut c.enabled, "collisions");
+        ui.add(
+            egui::Slider::new(&mut c.thickness, 0.0005..=0.02)
+                .logarithmic(true)
+                .text("thickness"),
+        );
+        ui.add(egui::Slider::new(&mut c.friction, 0.0..=1.5).text("friction"));
+        ui.add(egui::Slider::new(&mut c.restitution, 0.0..=1.0).text("restitution"));
+        ui.checkbox(&mut c.check_crossings, "check crossings every step");
+    });
+    edit(&mut settings.draw, |d| {
+        ui.checkbox(&mut d.color_by_error, "colour edges by length error");
+        ui.checkbox(
+            &mut d.particles,
+            format!("draw particles (up to {})", d.max_particle_dots),
+        );
+    });
+}
+
+/// Space run/pause, R reset, E record frames, = and − substeps.
+fn shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    layout: Res<UiLayout>,
+    mut step: ResMut<StrandsConfig>,
+    mut collisions: ResMut<CollisionConfig>,
+    mut metrics: ResMut<StrandMetrics>,
+    mut commands: Commands,
+) {
+    if layout.keyboard_over_ui {
+        return;
+    }
+    if keys.just_pressed(KeyCode::Space) {
+        step.paused = !step.paused;
+    }
+    if keys.just_pressed(KeyCode::KeyR) {
+        commands.queue(reset);
+    }
+    if keys.just_pressed(KeyCode::KeyE) {
+        commands.queue(toggle_export);
+    }
+    if keys.any_just_pressed([KeyCode::Equal, KeyCode::NumpadAdd]) {
+        step.substeps += 1;
+    }
+    if keys.any_just_pressed([KeyCode::Minus, KeyCode::NumpadSubtract]) && step.substeps > 1 {
+        step.substeps -= 1;
+    }
+    // Crossings counted from when checking is switched on.
+    if collisions.is_changed() && collisions.check_crossings && metrics.edge_crossings.is_none() {
+        metrics.edge_crossings = Some(0);
+    }
+    if collisions.is_changed() && !collisions.check_crossings {
+        metrics.edge_crossings = None;
+    }
+    let _ = &mut collisions;
+}
+
+/// Start the scene over: despawn everything it made, clear the figures, spawn it again.
+pub fn reset(world: &mut World) {
+    let mut doomed = world.query_filtered::<Entity, Or<(
+        With<Particle>,
+        With<Strand>,
+        With<SpaghettiFactory>,
+        With<MeatballFactory>,
+        With<FurryCreature>,
+    )>>();
+    let doomed: Vec<Entity> = doomed.iter(world).collect();
+    for entity in doomed {
+        if let Ok(e) = world.get_entity_mut(entity) {
+            e.despawn();
+        }
+    }
+    *world.resource_mut::<SimulationClock>() = SimulationClock::default();
+    let checked = world.resource::<CollisionConfig>().check_crossings;
+    let mut metrics = world.resource_mut::<StrandMetrics>();
+    metrics.reset_figures();
+    metrics.edge_crossings = checked.then_some(0);
+    world.resource_mut::<LengthErrorHistory>().samples.clear();
+    world.resource_mut::<InputProblems>().clear();
+    spawn_active_scenario(world);
+}
+
+fn toggle_export(world: &mut World) {
+    let view = world
+        .get_resource::<ActiveScenario>()
+        .map(|a| a.scenario.view());
+    let title = world
+        .get_resource::<ActiveScenario>()
+        .map_or("bevy_strands".to_string(), |a| a.scenario.name.clone());
+    let mut export = world.resource_mut::<FrameExport>();
+    if export.recorder.take().is_some() {
+        return;
+    }
+    let Some(view) = view else {
+        return;
+    };
+    let directory = export.directory.clone();
+    match Recorder::new(
+        FrameSettings::default(),
+        view,
+        &title,
+        None,
+        Some(&directory),
+    ) {
+        Ok(recorder) => {
+            export.recorder = Some(recorder);
+            export.message = None;
+        }
+        Err(e) => export.message = Some(e.to_string()),
+    }
+}
+
+fn export_frames(world: &mut World) {
+    let Some(mut recorder) = world.resource_mut::<FrameExport>().recorder.take() else {
+        return;
+    };
+    match recorder.capture_if_due(world) {
+        Ok(()) => world.resource_mut::<FrameExport>().recorder = Some(recorder),
+        Err(e) => world.resource_mut::<FrameExport>().message = Some(e.to_string()),
+    }
+}
+
+fn trim_history(mut history: ResMut<LengthErrorHistory>) {
+    if history.samples.len() > PLOT_SAMPLES {
+        let excess = history.samples.len() - PLOT_SAMPLES / 2;
+        history.samples.drain(..excess);
+    }
+}

@@ -1,0 +1,191 @@
+//! Scenario files: the built-in scenarios load, and every kind of bad input is refused with
+//! a message naming the file, the item and the problem.
+
+use bevy_strands_app::runner::{RunError, RunOptions, load_scenario};
+use bevy_strands_app::scenario::Scenario;
+use bevy_strands_app::scenes::BUILTIN_SCENES;
+
+const GOOD: &str = r#"(
+    name: "test",
+    duration: 1.0,
+    step: (dt: 0.001, substeps: 10),
+    container: Some((min: (0.0, 0.0), max: (1.0, 1.0))),
+    strands: [
+        (shape: Line(start: (0.1, 0.5), angle_degrees: 0.0, particles: 10, spacing: 0.05)),
+        (shape: Polyline(points: [(0.1, 0.2), (0.2, 0.2), (0.3, 0.25)]), mass: 2.0),
+    ],
+    particles: [(position: (0.5, 0.5))],
+)"#;
+
+fn rejected(text: &str) -> String {
+    match Scenario::parse(text, "bad.ron") {
+        Ok(_) => panic!("scene was accepted:\n{text}"),
+        Err(e) => {
+            let message = e.to_string();
+            assert!(message.starts_with("bad.ron: "), "{message}");
+            message
+        }
+    }
+}
+
+#[test]
+fn builtin_scenes_are_valid() {
+    for scene in BUILTIN_SCENES {
+        let parsed = scene.scenario().unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(parsed.name, scene.name);
+    }
+}
+
+#[test]
+fn a_good_scene_parses() {
+    let scene = Scenario::parse(GOOD, "good.ron").unwrap();
+    assert_eq!(scene.strands.len(), 2);
+}
+
+#[test]
+fn nan_and_infinite_numbers_are_rejected() {
+    let message = rejected(&GOOD.replace("start: (0.1, 0.5)", "start: (NaN, 0.5)"));
+    assert!(message.contains("strands[0].shape.start") && message.contains("not finite"));
+    let message = rejected(&GOOD.replace("(0.2, 0.2)", "(0.2, inf)"));
+    assert!(message.contains("strands[1].shape.points[1]") && message.contains("not finite"));
+    let message = rejected(&GOOD.replace("dt: 0.001", "dt: inf"));
+    assert!(message.contains("dt") && message.contains("positive and finite"));
+}
+
+#[test]
+fn non_positive_masses_are_rejected() {
+    let message = rejected(&GOOD.replace("mass: 2.0", "mass: -2.0"));
+    assert!(
+        message.contains("strands[1].mass: -2 must be positive"),
+        "{message}"
+    );
+    let message = rejected(&GOOD.replace(
+        "(position: (0.5, 0.5))",
+        "(position: (0.5, 0.5), mass: 0.0)",
+    ));
+    assert!(message.contains("particles[0].mass"), "{message}");
+}
+
+#[test]
+fn a_strand_of_fewer_than_two_particles_is_rejected() {
+    let message = rejected(&GOOD.replace("particles: 10", "particles: 1"));
+    assert!(message.contains("strands[0].shape.particles") && message.contains("at least 2"));
+    let message = rejected(&GOOD.replace("[(0.1, 0.2), (0.2, 0.2), (0.3, 0.25)]", "[(0.1, 0.2)]"));
+    assert!(
+        message.contains("strands[1]") && message.contains("at least 2"),
+        "{message}"
+    );
+}
+
+#[test]
+fn zero_or_negative_rest_lengths_are_rejected() {
+    let message = rejected(&GOOD.replace("spacing: 0.05", "spacing: 0.0"));
+    assert!(message.contains("strands[0].shape.spacing") && message.contains("rest length"));
+    let message =
+        rejected(&GOOD.replace("mass: 2.0", "mass: 2.0, rest_lengths: Some([0.1, -0.1])"));
+    assert!(
+        message.contains("strands[1]") && message.contains("rest length of edge 1"),
+        "{message}"
+    );
+}
+
+#[test]
+fn coincident_consecutive_particles_are_rejected() {
+    let message = rejected(&GOOD.replace("(0.2, 0.2), (0.3, 0.25)", "(0.2, 0.2), (0.2, 0.2)"));
+    assert!(
+        message.contains("strands[1]") && message.contains("particles 1 and 2 coincide"),
+        "{message}"
+    );
+}
+
+#[test]
+fn links_must_name_two_existing_separate_particles_once() {
+    let with_links = |links: &str| {
+        GOOD.replace(
+            "particles: [(",
+            &format!("links: [{links}],\n    particles: [("),
+        )
+    };
+    let good = Scenario::parse(&with_links("(from: (0, 9), to: (1, 0))"), "good.ron").unwrap();
+    assert_eq!(good.links.len(), 1);
+    let message = rejected(&with_links("(from: (0, 1), to: (2, 0))"));
+    assert!(
+        message.contains("links[0].to: strand 2 does not exist; the scene has 2 strands"),
+        "{message}"
+    );
+    let message = rejected(&with_links("(from: (0, 10), to: (1, 0))"));
+    assert!(
+        message.contains("links[0].from: strand 0 has no particle 10; it has 10"),
+        "{message}"
+    );
+    let message = rejected(&with_links("(from: (1, 2), to: (1, 2))"));
+    assert!(
+        message.contains("links[0]: an edge needs two different particles"),
+        "{message}"
+    );
+    // Particle 2 of strand 0 sits at (0.2, 0.5); a new strand puts its first there too.
+    let coincident = with_links("(from: (0, 2), to: (2, 0))").replace(
+        "mass: 2.0),",
+        "mass: 2.0),\n        (shape: Polyline(points: [(0.2, 0.5), (0.2, 0.6)])),",
+    );
+    let message = rejected(&coincident);
+    assert!(
+        message.contains("links[0]: its particles coincide")
+            && message.contains("zero rest length"),
+        "{message}"
+    );
+    let message = rejected(&with_links(
+        "(from: (0, 9), to: (1, 0)), (from: (1, 0), to: (0, 9))",
+    ));
+    assert!(
+        message.contains("links[1]: joins the same two particles as an earlier link"),
+        "{message}"
+    );
+}
+
+#[test]
+fn syntax_errors_and_unknown_fields_name_the_place() {
+    let message = rejected(&GOOD.replace("substeps: 10", "substeps: 10, speed: 3"));
+    assert!(message.contains("line 4"), "{message}");
+    let message = rejected(&GOOD.replace(
+        "duration: 1.0,",
+        "duration: 1.0,\n    constraints: (solver: \"magic\"),",
+    ));
+    assert!(
+        message.contains("line 4") && message.contains("valid solvers"),
+        "{message}"
+    );
+}
+
+#[test]
+fn unknown_scenarios_and_bad_overrides_are_refused() {
+    let options = RunOptions {
+        scenario: "no_such_scene".into(),
+        ..Default::default()
+    };
+    match load_scenario(&options) {
+        Err(RunError::UnknownScenario { valid, .. }) => assert!(valid.contains("long_strand")),
+        other => panic!("{other:?}"),
+    }
+    let options = RunOptions {
+        scenario: "long_strand".into(),
+        dt: Some(-1.0),
+        ..Default::default()
+    };
+    let message = load_scenario(&options).unwrap_err().to_string();
+    assert!(message.contains("command line: step.dt"), "{message}");
+}
+
+#[test]
+fn a_missing_file_is_reported_by_name() {
+    let options = RunOptions {
+        scenario: "x".into(),
+        scene_file: Some("does/not/exist.ron".into()),
+        ..Default::default()
+    };
+    let message = load_scenario(&options).unwrap_err().to_string();
+    assert!(
+        message.starts_with("does/not/exist.ron: file:"),
+        "{message}"
+    );
+}

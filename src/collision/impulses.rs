@@ -1,0 +1,341 @@
+//! Collision impulses over one step's motion, on slices: the proximity pass that keeps
+//! pairs a thickness apart, continuous detection with an inelastic, frictional impulse
+//! per collision repeated until a pass is clean, and the fail-safe when the cap is hit.
+//!
+//! Each pass tests the candidate pairs of the broad phase in a fixed order and applies
+//! every impulse as it is found, so later tests see the velocities earlier impulses
+//! left. Every contact met is recorded (one per point and edge, the latest), for the
+//! contact loop's rows.
+
+use bevy::math::DVec2;
+use bevy::platform::collections::HashMap;
+
+use super::broad_phase::{BroadPhase, BroadPhaseMethod};
+use super::ccd::point_edge_time_of_impact;
+use super::failsafe::ImpactZones;
+use super::response::{collision_normal_change, contact_change, repulsion_normal_change};
+use crate::model::geometry::closest_on_segment;
+use crate::model::motion::{displacement, displacements, end_of_step};
+use crate::model::{Edge, PointEdgePair};
+
+/// The collision settings the passes use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpulseSettings {
+    /// Thickness `h`: pairs are kept at least this far apart.
+    pub thickness: f64,
+    /// Coulomb friction coefficient.
+    pub friction: f64,
+    /// Restitution of collision impulses.
+    pub restitution: f64,
+    /// Detection passes before the fail-safe.
+    pub max_iterations: u32,
+    /// How candidate pairs are found.
+    pub broad_phase: BroadPhaseMethod,
+}
+
+/// A contact met this step: point `p` against edge `edge` at `alpha`, along `normal`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// The point (packed index).
+    pub p: u32,
+    /// The edge (index into the edge list).
+    pub edge: u32,
+    /// Where on the edge: `(1 − α) a + α b`.
+    pub alpha: f64,
+    /// The contact normal, pointing from the edge to the point.
+    pub normal: DVec2,
+}
+
+/// The passes' buffers, reused every step.
+#[derive(Clone, Debug, Default)]
+pub struct ImpulseScratch {
+    broad: BroadPhase,
+    /// Candidate (point, edge) pairs of the latest broad phase.
+    pub pairs: Vec<(u32, u32)>,
+    displacement: Vec<DVec2>,
+    /// Every contact met this step, one per point and edge.
+    pub contacts: Vec<Contact>,
+    contact_index: HashMap<(u32, u32), u32>,
+    /// The fail-safe's rigid impact zones of this step.
+    pub zones: ImpactZones,
+    hits: Vec<(u32, u32, u32)>,
+}
+
+impl ImpulseScratch {
+    /// Forget the previous step's contacts and zones.
+    pub fn begin_step(&mut self, particles: usize) {
+        self.contacts.clear();
+        self.contact_index.clear();
+        self.zones.reset(particles);
+    }
+
+    /// Whether point `p` met edge `edge` this step.
+    pub fn met(&self, p: u32, edge: u32) -> bool {
+        self.contact_index.contains_key(&(p, edge))
+    }
+}
+
+/// How one step's collision processing went.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CollisionOutcome {
+    /// Impulses applied (proximity and collision).
+    pub impulses: u64,
+    /// Whether the fail-safe had to run.
+    pub failsafe: bool,
+    /// Collisions the fail-safe could not resolve (kinematic particles driven into
+    /// each other); 0 in every sound scene.
+    pub unresolved: usize,
+}
+
+impl CollisionOutcome {
+    /// Add another round's figures.
+    pub fn add(&mut self, other: CollisionOutcome) {
+        self.impulses += other.impulses;
+        self.failsafe |= other.failsafe;
+        self.unresolved += other.unresolved;
+    }
+}
+
+/// The slices and settings of one step's collision processing.
+pub struct Collider<'a> {
+    /// Every edge (walls included).
+    pub edges: &'a [Edge],
+    /// Positions at the start of the step.
+    pub position: &'a [DVec2],
+    /// Velocities: the step's motion, changed by the impulses.
+    pub velocity: &'a mut [DVec2],
+    /// Masses.
+    pub mass: &'a [f64],
+    /// Inverse masses (0: pinned).
+    pub inverse_mass: &'a [f64],
+    /// Set for every free particle that takes part in a contact.
+    pub in_contact: &'a mut [bool],
+    /// The settings.
+    pub settings: &'a ImpulseSettings,
+    /// The step.
+    pub dt: f64,
+    /// The buffers.
+    pub scratch: &'a mut ImpulseScratch,
+}
+
+impl Collider<'_> {
+    /// Candidate (point, edge) pairs for the current velocities.
+    pub fn find_pairs(&mut self) {
+        let scratch = &mut *self.scratch;
+        displacements(self.velocity, self.dt, &mut scratch.displacement);
+        scratch.broad.build(
+            self.edges,
+            self.position,
+            Some(&scratch.displacement),
+            self.settings.thickness,
+        );
+        scratch.pairs.clear();
+        let (edges, w) = (self.edges, self.inverse_mass);
+        let keep = |p: u32, k: u32| {
+            let e = &edges[k as usize];
+            e.a != p
+                && e.b != p
+                && (w[p as usize] > 0.0 || w[e.a as usize] > 0.0 || w[e.b as usize] > 0.0)
+        };
+        scratch.broad.point_edge_pairs(
+            self.settings.broad_phase,
+            self.position,
+            &scratch.displacement,
+            keep,
+            &mut scratch.pairs,
+        );
+    }
+
+    fn pair(&self, p: u32, k: u32, alpha: f64) -> PointEdgePair {
+        let e = &self.edges[k as usize];
+        PointEdgePair {
+            p: p as usize,
+            q: e.a as usize,
+            r: e.b as usize,
+            alpha,
+        }
+    }
+
+    /// A relative speed that moves a pair by a billionth of the thickness per step:
+    /// below it, an approach is round-off, not a collision.
+    fn negligible_speed(&self) -> f64 {
+        1e-9 * self.settings.thickness.max(1e-9) / self.dt
+    }
+
+    /// Apply a relative-velocity change and record the contact.
+    fn respond(&mut self, pair: PointEdgePair, edge: u32, delta: DVec2, normal: DVec2) -> bool {
+        if !pair.apply(delta, self.velocity, self.inverse_mass) {
+            return false;
+        }
+        for i in [pair.p, pair.q, pair.r] {
+            self.in_contact[i] |= self.inverse_mass[i] > 0.0;
+        }
+        let contact = Contact {
+            p: pair.p as u32,
+            edge,
+            alpha: pair.alpha,
+            normal,
+        };
+        // One record per point and edge: the latest contact between them.
+        let scratch = &mut *self.scratch;
+        let next = scratch.contacts.len() as u32;
+        let slot = *scratch
+            .contact_index
+            .entry((contact.p, edge))
+            .or_insert(next);
+        if slot == next {
+            scratch.contacts.push(contact);
+        } else {
+            scratch.contacts[slot as usize] = contact;
+        }
+        true
+    }
+
+    /// Repulsion for pairs that would end the step closer than the thickness.
+    pub fn proximity_pass(&mut self) -> u64 {
+        let mut impulses = 0;
+        for slot in 0..self.scratch.pairs.len() {
+            let (p, k) = self.scratch.pairs[slot];
+            let e = &self.edges[k as usize];
+            let (x, q, r) = (
+                self.position[p as usize],
+                self.position[e.a as usize],
+                self.position[e.b as usize],
+            );
+            let (alpha, distance) = closest_on_segment(x, q, r);
+            let pair = self.pair(p, k, alpha);
+            let relative = pair.relative_velocity(self.velocity);
+            let closest = q.lerp(r, alpha);
+            let normal = if distance > 0.0 {
+                (x - closest) / distance
+            } else {
+                // On the edge: push against the approach, or off the edge's side.
+                let side = (r - q).perp().normalize_or(DVec2::Y);
+                if side.dot(relative) > 0.0 {
+                    -side
+                } else {
+                    side
+                }
+            };
+            let change = repulsion_normal_change(
+                distance,
+                normal.dot(relative),
+                self.settings.thickness,
+                self.dt,
+            );
+            // A few ulps short of the thickness is at the thickness.
+            if change <= 1e-9 * self.settings.thickness / self.dt {
+                continue;
+            }
+            let delta = contact_change(relative, normal, change, self.settings.friction);
+            impulses += u64::from(self.respond(pair, k, delta, normal));
+        }
+        impulses
+    }
+
+    /// One detection pass over the current pairs; impulses are applied as found, each
+    /// test using the velocities the earlier impulses left.
+    fn collision_pass(&mut self) -> u64 {
+        let mut impulses = 0;
+        for slot in 0..self.scratch.pairs.len() {
+            let (p, k) = self.scratch.pairs[slot];
+            let Some((pair, normal, normal_velocity)) = self.approaching_hit(p, k) else {
+                continue;
+            };
+            let change = collision_normal_change(normal_velocity, self.settings.restitution);
+            let relative = pair.relative_velocity(self.velocity);
+            let delta = contact_change(relative, normal, change, self.settings.friction);
+            impulses += u64::from(self.respond(pair, k, delta, normal));
+        }
+        impulses
+    }
+
+    /// The contact of point `p` with edge `k` over the step, if they meet approaching.
+    fn approaching_hit(&self, p: u32, k: u32) -> Option<(PointEdgePair, DVec2, f64)> {
+        let e = &self.edges[k as usize];
+        let (a, b, i) = (e.a as usize, e.b as usize, p as usize);
+        let dt = self.dt;
+        let hit = point_edge_time_of_impact(
+            self.position[i],
+            displacement(self.velocity[i], dt),
+            self.position[a],
+            displacement(self.velocity[a], dt),
+            self.position[b],
+            displacement(self.velocity[b], dt),
+        )?;
+        let pair = self.pair(p, k, hit.alpha);
+        let normal_velocity = hit.normal.dot(pair.relative_velocity(self.velocity));
+        // Touching while moving apart (or not at all) is no collision; creeping through
+        // the edge, however slowly, is one.
+        let approaching = normal_velocity < -self.negligible_speed();
+        let creeping = !approaching && normal_velocity < 0.0 && {
+            let end = |x: usize| end_of_step(self.position[x], self.velocity[x], dt);
+            hit.normal.dot(end(i) - end(a).lerp(end(b), hit.alpha)) < 0.0
+        };
+        (approaching || creeping).then_some((pair, hit.normal, normal_velocity))
+    }
+
+    /// Detection and impulses until a full pass finds no collision or the cap is hit;
+    /// then the fail-safe. Leaves the velocities collision-free. `stale`: the current
+    /// pairs predate a velocity change.
+    pub fn resolve_crossings(&mut self, mut stale: bool) -> CollisionOutcome {
+        let mut outcome = CollisionOutcome::default();
+        for _ in 0..self.settings.max_iterations {
+            if stale {
+                self.find_pairs();
+            }
+            let impulses = self.collision_pass();
+            outcome.impulses += impulses;
+            if impulses == 0 {
+                return outcome;
+            }
+            stale = true;
+        }
+        outcome.failsafe = true;
+        outcome.unresolved = self.fail_safe();
+        outcome
+    }
+
+    /// Rigid impact zones until no approaching contact is left; returns the number
+    /// left unresolved.
+    fn fail_safe(&mut self) -> usize {
+        let n = self.position.len();
+        self.scratch.zones.reset(n);
+        for _round in 0..(4 * n + 16) {
+            self.find_pairs();
+            self.scratch.hits.clear();
+            for slot in 0..self.scratch.pairs.len() {
+                let (p, k) = self.scratch.pairs[slot];
+                if let Some((pair, ..)) = self.approaching_hit(p, k) {
+                    self.scratch
+                        .hits
+                        .push((pair.p as u32, pair.q as u32, pair.r as u32));
+                }
+            }
+            if self.scratch.hits.is_empty() {
+                break;
+            }
+            let zones = &mut self.scratch.zones;
+            let mut merged = false;
+            for &(p, q, r) in &self.scratch.hits {
+                merged |= zones.join(p as usize, q as usize);
+                merged |= zones.join(p as usize, r as usize);
+            }
+            if !merged {
+                // Collisions inside zones: their rotation is the culprit.
+                let mut stopped = false;
+                for &(p, ..) in &self.scratch.hits {
+                    stopped |= zones.stop_rotation(p as usize);
+                }
+                if !stopped {
+                    return self.scratch.hits.len();
+                }
+            }
+            zones.rigidify(self.position, self.velocity, self.mass, self.inverse_mass);
+        }
+        for &i in self.scratch.zones.members() {
+            self.in_contact[i as usize] |= self.inverse_mass[i as usize] > 0.0;
+        }
+        0
+    }
+}

@@ -1,0 +1,189 @@
+//! The Collide stage's systems (all but the contact loop) and the crossing check.
+
+use bevy::prelude::*;
+
+use super::broad_phase::BroadPhase;
+use super::crossings::count_crossings;
+use super::impulses::{Collider, CollisionOutcome, ImpulseScratch, ImpulseSettings};
+use crate::metrics::{StrandMetrics, measure};
+use crate::schedule::{CollideSet, StepSet, StrandsStep};
+use crate::world::config::{CollisionConfig, StrandsConfig};
+use crate::world::state::ParticleState;
+use crate::world::topology::Topology;
+
+/// The Collide stage's buffers and the step's collision figures so far.
+#[derive(Resource, Default, Debug)]
+pub struct CollisionScratch {
+    /// The impulse passes' buffers: pairs, contacts, impact zones.
+    pub impulses: ImpulseScratch,
+    /// What the step's collision processing has done so far.
+    pub outcome: CollisionOutcome,
+    /// Whether the pairs predate the proximity impulses' velocity change.
+    stale: bool,
+    crossing_pairs: Vec<(u32, u32)>,
+    crossing_broad: BroadPhase,
+}
+
+/// Proximity and collision impulses, the step's collision figures and the crossing check.
+pub struct CollisionPlugin;
+
+impl Plugin for CollisionPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<CollisionConfig>()
+            .init_resource::<CollisionScratch>()
+            .register_type::<CollisionConfig>()
+            .add_systems(
+                StrandsStep,
+                (
+                    proximity.in_set(CollideSet::Proximity),
+                    impulses.in_set(CollideSet::Impulses),
+                    account_collisions.in_set(CollideSet::Account),
+                    check_crossings.in_set(StepSet::Measure).after(measure),
+                ),
+            );
+    }
+}
+
+impl CollisionConfig {
+    /// The settings of the impulse passes.
+    pub fn impulse_settings(&self) -> ImpulseSettings {
+        ImpulseSettings {
+            thickness: self.thickness,
+            friction: self.friction,
+            restitution: self.restitution,
+            max_iterations: self.max_iterations,
+            broad_phase: self.broad_phase,
+        }
+    }
+}
+
+/// The packed state, the edges and the buffers as a [`Collider`] for one step.
+pub fn collider<'a>(
+    state: &'a mut ParticleState,
+    topology: &'a Topology,
+    settings: &'a ImpulseSettings,
+    dt: f64,
+    scratch: &'a mut ImpulseScratch,
+) -> Collider<'a> {
+    let ParticleState {
+        position,
+        velocity,
+        mass,
+        inverse_mass,
+        in_contact,
+        ..
+    } = state;
+    Collider {
+        edges: &topology.edges,
+        position,
+        velocity,
+        mass,
+        inverse_mass,
+        in_contact,
+        settings,
+        dt,
+        scratch,
+    }
+}
+
+/// Proximity sub-stage: forget the previous step's contacts, find the candidate pairs,
+/// push apart those that would end the step closer than the thickness.
+pub fn proximity(
+    config: Res<CollisionConfig>,
+    step: Res<StrandsConfig>,
+    topology: Res<Topology>,
+    mut state: ResMut<ParticleState>,
+    mut scratch: ResMut<CollisionScratch>,
+) {
+    state.in_contact.fill(false);
+    if !config.enabled {
+        return;
+    }
+    let scratch = &mut *scratch;
+    scratch.impulses.begin_step(state.len());
+    let settings = config.impulse_settings();
+    let mut collider = collider(
+        &mut state,
+        &topology,
+        &settings,
+        step.dt,
+        &mut scratch.impulses,
+    );
+    collider.find_pairs();
+    let impulses = collider.proximity_pass();
+    scratch.outcome = CollisionOutcome {
+        impulses,
+        ..default()
+    };
+    scratch.stale = impulses > 0;
+}
+
+/// Impulses sub-stage: detection and impulses until a pass is clean, then the fail-safe.
+pub fn impulses(
+    config: Res<CollisionConfig>,
+    step: Res<StrandsConfig>,
+    topology: Res<Topology>,
+    mut state: ResMut<ParticleState>,
+    mut scratch: ResMut<CollisionScratch>,
+) {
+    if !config.enabled {
+        return;
+    }
+    let scratch = &mut *scratch;
+    let settings = config.impulse_settings();
+    let mut collider = collider(
+        &mut state,
+        &topology,
+        &settings,
+        step.dt,
+        &mut scratch.impulses,
+    );
+    let crossings = collider.resolve_crossings(scratch.stale);
+    // The proximity impulses were counted first.
+    let proximity = scratch.outcome.impulses;
+    scratch.outcome = crossings;
+    scratch.outcome.impulses += proximity;
+}
+
+/// Account sub-stage: the step's collision figures into the metrics.
+pub fn account_collisions(
+    config: Res<CollisionConfig>,
+    scratch: Res<CollisionScratch>,
+    mut metrics: ResMut<StrandMetrics>,
+) {
+    if !config.enabled {
+        return;
+    }
+    let total = scratch.outcome;
+    metrics.collisions += total.impulses;
+    metrics.collisions_last_step = total.impulses;
+    metrics.failsafe_steps += u64::from(total.failsafe);
+    metrics.unresolved_collisions += total.unresolved as u64;
+}
+
+/// The Measure stage's crossing check (checked mode only).
+pub fn check_crossings(
+    config: Res<CollisionConfig>,
+    topology: Res<Topology>,
+    state: Res<ParticleState>,
+    mut scratch: ResMut<CollisionScratch>,
+    mut metrics: ResMut<StrandMetrics>,
+) {
+    if !config.check_crossings {
+        return;
+    }
+    let CollisionScratch {
+        crossing_pairs,
+        crossing_broad,
+        ..
+    } = &mut *scratch;
+    let crossings = count_crossings(
+        &topology.edges,
+        &state.position,
+        crossing_broad,
+        config.broad_phase,
+        crossing_pairs,
+    );
+    metrics.crossing_pairs_last_step = crossings;
+    *metrics.edge_crossings.get_or_insert(0) += u64::from(crossings > 0);
+}

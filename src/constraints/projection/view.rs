@@ -1,0 +1,81 @@
+//! What a projection reads and writes: the particle slices, and the island as a chain
+//! or a graph.
+
+use bevy::math::DVec2;
+
+use crate::constraints::graph::GraphLayout;
+use crate::constraints::island_edge::IslandEdge;
+
+/// The particle slices a projection reads and writes.
+#[derive(Debug)]
+pub struct Bodies<'a> {
+    /// Positions at the start of the step.
+    pub position: &'a [DVec2],
+    /// Predictor velocities in, projected velocities out.
+    pub velocity: &'a mut [DVec2],
+    /// Inverse masses (0: pinned).
+    pub inverse_mass: &'a [f64],
+    /// Particles whose velocity the projection must leave alone (a rigid impact zone's
+    /// members), as if pinned for this solve; `None`: none.
+    pub held: Option<&'a [bool]>,
+}
+
+impl<'a> Bodies<'a> {
+    /// The slices, with nothing held.
+    pub fn new(position: &'a [DVec2], velocity: &'a mut [DVec2], inverse_mass: &'a [f64]) -> Self {
+        Self {
+            position,
+            velocity,
+            inverse_mass,
+            held: None,
+        }
+    }
+
+    /// The same slices, reborrowed for one solve.
+    pub fn reborrow(&mut self) -> Bodies<'_> {
+        Bodies {
+            position: self.position,
+            velocity: &mut *self.velocity,
+            inverse_mass: self.inverse_mass,
+            held: self.held,
+        }
+    }
+
+    /// Inverse mass of particle `i` for this solve: 0 if pinned or held.
+    #[inline]
+    pub fn weight(&self, i: usize) -> f64 {
+        if self.held.is_some_and(|held| held[i]) {
+            0.0
+        } else {
+            self.inverse_mass[i]
+        }
+    }
+}
+
+/// A path or loop island: its edges in walking order (edge k + 1 starts where edge k
+/// ends; when `closed`, the last ends where the first starts).
+#[derive(Clone, Copy, Debug)]
+pub struct Chain<'a> {
+    /// The edges, in order.
+    pub edges: &'a [IslandEdge],
+    /// Whether the chain is a loop.
+    pub closed: bool,
+}
+
+/// A tree or graph island: its edges in the layout's order, and the layout.
+#[derive(Clone, Copy, Debug)]
+pub struct Graph<'a> {
+    /// The edges, in [`GraphLayout`] order.
+    pub edges: &'a [IslandEdge],
+    /// Local particles, incidence and the sparse plan.
+    pub layout: &'a GraphLayout,
+}
+
+/// Any island the projection solves.
+#[derive(Clone, Copy, Debug)]
+pub enum IslandView<'a> {
+    /// A path or a loop: a tridiagonal or cyclic tridiagonal system.
+    Chain(Chain<'a>),
+    /// A tree or graph: a sparse LDLᵀ.
+    Graph(Graph<'a>),
+}

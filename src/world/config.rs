@@ -1,0 +1,269 @@
+//! Configuration resources: the step, the constraint solver, collisions and the contact
+//! loop. Every tunable of the simulation lives here, with its default and its meaning;
+//! [`validate`](StrandsConfig::validate) methods check each number against that meaning,
+//! and scene files deserialize into these same types (feature `serde`).
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::collision::broad_phase::BroadPhaseMethod;
+use crate::constraints::projection::{ConstraintDirection, ProjectionSettings};
+use crate::constraints::solver::SolverKind;
+use crate::model::validate::{
+    NumberError, at_least, finite_vector, non_negative, positive, within,
+};
+use crate::world::strand::StrandMaterial;
+
+/// Step size, substeps and the global force parameters.
+///
+/// Each fixed tick runs `substeps` steps of `dt` seconds. The defaults are the
+/// canonical scenes': 30 steps of 1/3000 s per 1/100 s tick.
+///
+/// ```
+/// # use bevy::prelude::*;
+/// # use bevy_strands::prelude::*;
+/// let mut app = App::new();
+/// app.add_plugins(StrandsPlugin::manual());
+/// let mut config = app.world_mut().resource_mut::<StrandsConfig>();
+/// config.dt = 1.0 / 60.0;
+/// config.substeps = 1;
+/// ```
+#[derive(Resource, Reflect, Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+#[reflect(Resource)]
+pub struct StrandsConfig {
+    /// Step size in seconds.
+    pub dt: f64,
+    /// Steps per fixed tick.
+    pub substeps: u32,
+    /// Gravity acceleration.
+    pub gravity: DVec2,
+    /// Mass-proportional damping coefficient (1/s): `f = −c m v`.
+    pub damping: f64,
+    /// Material of strands that carry no [`StrandMaterial`] of their own.
+    pub material: StrandMaterial,
+    /// Whether ticks advance the simulation. A paused simulation keeps its state.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub paused: bool,
+}
+
+impl Default for StrandsConfig {
+    fn default() -> Self {
+        Self {
+            dt: 1.0 / 3000.0,
+            substeps: 30,
+            gravity: DVec2::new(0.0, -9.81),
+            damping: 0.0,
+            material: StrandMaterial::default(),
+            paused: false,
+        }
+    }
+}
+
+impl StrandsConfig {
+    /// Simulated seconds per fixed tick.
+    pub fn tick_seconds(&self) -> f64 {
+        self.dt * self.substeps as f64
+    }
+
+    /// Check every number against its meaning.
+    pub fn validate(&self) -> Result<(), NumberError> {
+        positive("dt", self.dt)?;
+        at_least("substeps", self.substeps as usize, 1, "a tick")?;
+        finite_vector("gravity", self.gravity)?;
+        non_negative("damping", self.damping)?;
+        self.material.validate().map_err(|e| e.within("material"))
+    }
+}
+
+/// Constraint solver settings.
+///
+/// ```
+/// # use bevy::prelude::*;
+/// # use bevy_strands::prelude::*;
+/// # use bevy_strands::constraints::projection::ConstraintDirection;
+/// let mut app = App::new();
+/// app.add_plugins(StrandsPlugin::manual());
+/// let mut config = app.world_mut().resource_mut::<ConstraintConfig>();
+/// config.tolerance = 1e-10;
+/// config.direction = ConstraintDirection::StartOfStep;
+/// ```
+#[derive(Resource, Reflect, Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+#[reflect(Resource)]
+pub struct ConstraintConfig {
+    /// The solver.
+    pub solver: SolverKind,
+    /// Stop projecting when every `|C_k| / L_k²` is at most this (≈ twice the
+    /// relative length error).
+    pub tolerance: f64,
+    /// Linear solves per island per step at most (sweeps, for the relaxation baselines).
+    pub max_iterations: u32,
+    /// Where the constraint direction is evaluated.
+    pub direction: ConstraintDirection,
+    /// Keep stretch springs on constrained edges too (constraint-drift studies).
+    pub stretch_springs: bool,
+}
+
+impl Default for ConstraintConfig {
+    fn default() -> Self {
+        Self {
+            solver: SolverKind::Tridiagonal,
+            tolerance: 1e-12,
+            max_iterations: 20,
+            direction: ConstraintDirection::EndOfStep,
+            stretch_springs: false,
+        }
+    }
+}
+
+impl ConstraintConfig {
+    /// The projection's stopping rule.
+    pub fn projection(&self) -> ProjectionSettings {
+        ProjectionSettings {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            direction: self.direction,
+            contact_tolerance: 0.0,
+            max_correction: f64::INFINITY,
+        }
+    }
+
+    /// Check every number against its meaning.
+    pub fn validate(&self) -> Result<(), NumberError> {
+        positive("tolerance", self.tolerance)?;
+        at_least("max_iterations", self.max_iterations as usize, 1, "a solve")
+    }
+}
+
+/// Collision settings.
+///
+/// ```
+/// # use bevy::prelude::*;
+/// # use bevy_strands::prelude::*;
+/// let mut app = App::new();
+/// app.add_plugins(StrandsPlugin::manual());
+/// let mut config = app.world_mut().resource_mut::<CollisionConfig>();
+/// config.friction = 0.5;
+/// config.thickness = 0.002;
+/// ```
+#[derive(Resource, Reflect, Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+#[reflect(Resource)]
+pub struct CollisionConfig {
+    /// Whether the Collide stage runs.
+    pub enabled: bool,
+    /// Thickness `h`: pairs are kept at least this far apart.
+    pub thickness: f64,
+    /// Coulomb friction coefficient.
+    pub friction: f64,
+    /// Restitution of collision impulses (0: inelastic, 1: elastic).
+    pub restitution: f64,
+    /// Detection passes before the fail-safe.
+    pub max_iterations: u32,
+    /// How candidate pairs are found.
+    pub broad_phase: BroadPhaseMethod,
+    /// Count edge crossings at the end of every step.
+    pub check_crossings: bool,
+}
+
+impl Default for CollisionConfig {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            thickness: 0.004,
+            friction: 0.3,
+            restitution: 0.0,
+            max_iterations: 10,
+            broad_phase: BroadPhaseMethod::Grid,
+            check_crossings: false,
+        }
+    }
+}
+
+impl CollisionConfig {
+    /// Check every number against its meaning.
+    pub fn validate(&self) -> Result<(), NumberError> {
+        positive("thickness", self.thickness)?;
+        non_negative("friction", self.friction)?;
+        within("restitution", self.restitution, 0.0..=1.0)?;
+        at_least(
+            "max_iterations",
+            self.max_iterations as usize,
+            1,
+            "detection",
+        )
+    }
+}
+
+/// The contact loop's settings: how constraint re-projections with contact rows
+/// alternate with collision impulses inside the Collide stage.
+///
+/// After the first round of impulses, the islands that contacts touched are projected
+/// onto their constraints again with every contact as an inequality row, then detection
+/// runs again; this repeats until a pass applies no impulse or `passes` are done.
+#[derive(Resource, Reflect, Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+#[reflect(Resource)]
+pub struct ContactConfig {
+    /// Alternations of re-projection and collisions at most; they stop as soon as a
+    /// pass finds no new collision, so at small steps one or two run whatever the cap.
+    /// 0 leaves edges next to contacts as the impulses leave them.
+    pub passes: u32,
+    /// Gauss–Seidel sweeps over the islands in contact per re-projection, at most.
+    pub sweeps: u32,
+    /// A re-projection that would move any particle by more than this many of its
+    /// island's shortest rest lengths in one step is refused: room for a strand that
+    /// lands moving a good part of an edge per step, while a nearly dependent set of
+    /// rows asking for absurd corrections is still refused.
+    pub max_correction: f64,
+    /// Contact rows are met to this fraction of the thickness per step (the edges are
+    /// met exactly whatever the contacts do).
+    pub tolerance: f64,
+    /// A row may approach while the pair ends the step at least this fraction of the
+    /// thickness apart (the next proximity pass restores the rest); asking for no
+    /// approach at all over-constrains a jammed pile.
+    pub keep: f64,
+    /// Pairs closer than this many thicknesses get a row even without a contact.
+    pub reach: f64,
+}
+
+impl Default for ContactConfig {
+    fn default() -> Self {
+        Self {
+            passes: 16,
+            sweeps: 8,
+            max_correction: 2.0,
+            tolerance: 1e-3,
+            keep: 0.5,
+            reach: 2.0,
+        }
+    }
+}
+
+impl ContactConfig {
+    /// Check every number against its meaning.
+    pub fn validate(&self) -> Result<(), NumberError> {
+        at_least("sweeps", self.sweeps as usize, 1, "a re-projection")?;
+        positive("max_correction", self.max_correction)?;
+        positive("tolerance", self.tolerance)?;
+        within("keep", self.keep, 0.0..=1.0)?;
+        non_negative("reach", self.reach)
+    }
+}

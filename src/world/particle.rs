@@ -1,0 +1,95 @@
+//! Particle components: what a particle is, as data on an entity.
+//!
+//! State is `f64` throughout: the headline figure of this crate is a relative length
+//! error near machine precision, which `f32` cannot represent.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::world::hooks::on_structure_changed;
+
+/// Marks an entity as a simulated particle and brings in the components it needs.
+///
+/// ```
+/// # use bevy::prelude::*;
+/// # use bevy::math::DVec2;
+/// # use bevy_strands::prelude::*;
+/// # let mut world = World::new();
+/// world.spawn((Particle, Position(DVec2::new(0.5, 0.5)), Mass(2.0)));
+/// ```
+#[derive(Component, Reflect, Clone, Copy, Debug, Default)]
+#[reflect(Component)]
+#[require(Position, Velocity, Mass, SolverIndex)]
+#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+pub struct Particle;
+
+/// Position in world units (the canonical scenes use the unit box).
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component)]
+pub struct Position(pub DVec2);
+
+/// Velocity in world units per second.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component)]
+pub struct Velocity(pub DVec2);
+
+/// Mass of a free particle. Must be finite and positive; a particle with a bad mass is
+/// left out of the simulation with an error in
+/// [`InputProblems`](crate::world::problems::InputProblems).
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Deref, DerefMut)]
+#[reflect(Component)]
+pub struct Mass(pub f64);
+
+impl Default for Mass {
+    fn default() -> Self {
+        Mass(1.0)
+    }
+}
+
+/// A pinned particle has infinite mass: forces, constraints and collisions never move
+/// it. It still moves with its own [`Velocity`], so a pinned particle can be driven
+/// kinematically (the factory inlet, a hair root on a moving body).
+#[derive(Component, Reflect, Clone, Copy, Debug, Default)]
+#[reflect(Component)]
+#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+pub struct Pinned;
+
+/// A constant force applied to the particle each step, on top of gravity.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[reflect(Component)]
+pub struct ExternalForce(pub DVec2);
+
+/// Index of the particle in the packed solver arrays, maintained by the topology
+/// rebuild. `SolverIndex::NONE` means "not simulated" (not yet seen, or rejected).
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq, Eq)]
+#[reflect(Component)]
+pub struct SolverIndex(pub u32);
+
+impl SolverIndex {
+    /// Not part of the packed state.
+    pub const NONE: SolverIndex = SolverIndex(u32::MAX);
+
+    /// The packed index, if the particle is simulated.
+    pub fn get(self) -> Option<usize> {
+        (self != Self::NONE).then_some(self.0 as usize)
+    }
+}
+
+impl Default for SolverIndex {
+    fn default() -> Self {
+        Self::NONE
+    }
+}
+
+/// Pulls its particle towards `target` with `f = k (target − x) − c v`, every step: the
+/// force of a mouse drag or a game's grab.
+#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
+#[reflect(Component)]
+pub struct Tether {
+    /// Where the particle is pulled.
+    pub target: DVec2,
+    /// Spring stiffness (N/m).
+    pub stiffness: f64,
+    /// Damping of the particle's velocity (N·s/m).
+    pub damping: f64,
+}

@@ -1,0 +1,85 @@
+//! The packed particle state the step stages run on.
+//!
+//! Authoritative state lives on the particle entities. At the start of each tick it is
+//! gathered into these arrays, in the order the topology rebuild chose (strand by
+//! strand, so each path island is contiguous); the stages of every step read and
+//! write only the arrays; at the end of the tick positions and velocities are written
+//! back (the `sync` module's systems).
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+/// Structure-of-arrays particle state, indexed by each particle's `SolverIndex`.
+#[derive(Resource, Default, Debug, Clone)]
+pub struct ParticleState {
+    /// The entity of each packed particle.
+    pub entity: Vec<Entity>,
+    /// Position at the start of the current step (the end of the previous one).
+    pub position: Vec<DVec2>,
+    /// Velocity; after the predictor, the candidate velocity of this step.
+    pub velocity: Vec<DVec2>,
+    /// Force accumulator of the current step.
+    pub force: Vec<DVec2>,
+    /// Constant external force per particle.
+    pub external_force: Vec<DVec2>,
+    /// Mass (the pinned particles' too, for kinetic figures).
+    pub mass: Vec<f64>,
+    /// Inverse mass, 0 for pinned particles (the topology's `pinned` is the record of
+    /// which those are; this is derived from it at every gather).
+    pub inverse_mass: Vec<f64>,
+    /// Whether the particle took part in a contact this step.
+    pub in_contact: Vec<bool>,
+}
+
+impl ParticleState {
+    /// Number of packed particles.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether no particle is packed.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Whether particle `i` is pinned (infinite mass).
+    pub fn is_pinned(&self, i: usize) -> bool {
+        self.inverse_mass[i] == 0.0
+    }
+
+    /// Total linear momentum of the free particles.
+    pub fn linear_momentum(&self) -> DVec2 {
+        (0..self.len())
+            .filter(|&i| !self.is_pinned(i))
+            .map(|i| self.mass[i] * self.velocity[i])
+            .sum()
+    }
+
+    /// Total angular momentum of the free particles about `origin`.
+    pub fn angular_momentum(&self, origin: DVec2) -> f64 {
+        (0..self.len())
+            .filter(|&i| !self.is_pinned(i))
+            .map(|i| self.mass[i] * (self.position[i] - origin).perp_dot(self.velocity[i]))
+            .sum()
+    }
+
+    /// Kinetic energy of the free particles.
+    pub fn kinetic_energy(&self) -> f64 {
+        (0..self.len())
+            .filter(|&i| !self.is_pinned(i))
+            .map(|i| 0.5 * self.mass[i] * self.velocity[i].length_squared())
+            .sum()
+    }
+
+    pub(crate) fn resize(&mut self, entities: Vec<Entity>) {
+        let n = entities.len();
+        self.entity = entities;
+        self.position.resize(n, DVec2::ZERO);
+        self.velocity.resize(n, DVec2::ZERO);
+        self.force.resize(n, DVec2::ZERO);
+        self.external_force.resize(n, DVec2::ZERO);
+        self.mass.resize(n, 1.0);
+        self.inverse_mass.resize(n, 1.0);
+        self.in_contact.resize(n, false);
+    }
+}
