@@ -2,7 +2,7 @@
 # Screenshots of every windowed example on a machine with no display or GPU: a real X
 # window under Xvfb, rendered by Mesa's software Vulkan driver (lavapipe), saved through
 # Bevy's screenshot API after a number of frames (STRANDS_SCREENSHOT, see
-# src/render/screenshot.rs). Then one scripted drag: xdotool grabs a particle of the
+# app/src/window/screenshot.rs). Then one scripted drag: xdotool grabs a particle of the
 # resting long strand and pulls it up, and the display is captured mid-drag.
 #
 # Usage: scripts/screenshots.sh [output directory, default screenshots/]

@@ -97,7 +97,7 @@ pub struct StrandMetrics {
     pub constrained_edges: usize,
     /// Constraint projection iterations per island solve (the Constrain stage).
     pub projection: IterationStats,
-    /// Re-projections after contact (DESIGN §7).
+    /// Re-projections of islands in contact (the contact loop).
     pub contact_projection: IterationStats,
     /// Collision impulses applied.
     pub collisions: u64,

@@ -1,4 +1,4 @@
-//! A steady-state step allocates nothing (DESIGN §3), measured with a counting global
+//! A steady-state step allocates nothing, measured with a counting global
 //! allocator. This file is its own test binary so the counter sees only this test.
 
 use std::alloc::{GlobalAlloc, Layout, System};
