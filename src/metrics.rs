@@ -5,6 +5,7 @@
 //! every step. It is also kept separately for edges none of whose particles took part
 //! in a contact that step, because contact impulses come after the constraint solve.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::constraints::projection::ProjectionOutcome;
@@ -37,6 +38,7 @@ impl Plugin for MetricsPlugin {
 
 /// Running totals of a constraint solver's iterations.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct IterationStats {
     /// Island solves performed.
     pub solves: u64,
@@ -71,9 +73,15 @@ impl IterationStats {
 }
 
 /// Metrics of the running simulation.
-#[derive(Resource, Default, Debug, Clone)]
+#[derive(Resource, Default, Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default)
+)]
 pub struct StrandMetrics {
     /// Current `|ℓ − L| / L` of every edge of [`Topology::edges`] (0 for static ones).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub relative_length_error: Vec<f64>,
     /// Largest relative length error at the end of the latest step.
     pub max_rel_length_error_now: f64,
@@ -111,11 +119,71 @@ pub struct StrandMetrics {
     /// Collisions the fail-safe could not resolve (only kinematic particles driven
     /// into each other can cause these).
     pub unresolved_collisions: u64,
+    /// The latest of them, with its particles.
+    pub last_unresolved: Option<UnresolvedCollision>,
     /// Intersecting edge pairs at the end of the latest checked step.
     pub crossing_pairs_last_step: usize,
     /// Step ends at which two edges sharing no particle intersected; `None` when not
     /// checked.
     pub edge_crossings: Option<u64>,
+    /// The first step end at which edges crossed, with the edges (checked mode).
+    pub first_crossing: Option<CrossingEvent>,
+}
+
+/// A collision nothing could resolve: a point driven into an edge by kinematic
+/// particles (pinned and moving), so the step may end with them crossed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct UnresolvedCollision {
+    /// The step it happened in (1 for the first step).
+    pub step: u64,
+    /// The point, and the two particles of the edge.
+    pub particles: [Entity; 3],
+    /// Their positions at the start of the step.
+    pub positions: [DVec2; 3],
+}
+
+/// Two edges found crossing at the end of a step: where and when, and which particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CrossingEvent {
+    /// The step that ended with the crossing (1 for the first step).
+    pub step: u64,
+    /// Simulated time at its end.
+    pub time: f64,
+    /// How many pairs crossed at that step end.
+    pub pairs: usize,
+    /// The two edges of the first pair.
+    pub edges: [CrossedEdge; 2],
+}
+
+/// One edge of a crossing pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CrossedEdge {
+    /// The strand the edge belongs to.
+    pub strand: Entity,
+    /// The edge's number along its strand.
+    pub edge: u32,
+    /// Its two particles.
+    pub particles: [Entity; 2],
+    /// Their positions.
+    pub positions: [DVec2; 2],
+}
+
+impl CrossedEdge {
+    /// Edge `k` of the topology, as the particles of `state` place it.
+    pub fn of(k: usize, topology: &Topology, state: &ParticleState) -> Self {
+        let edge = &topology.edges[k];
+        let record = &topology.strands[edge.strand as usize];
+        let (a, b) = (edge.a as usize, edge.b as usize);
+        CrossedEdge {
+            strand: record.entity,
+            edge: (k - record.edges.start) as u32,
+            particles: [state.entity[a], state.entity[b]],
+            positions: [state.position[a], state.position[b]],
+        }
+    }
 }
 
 impl StrandMetrics {

@@ -231,3 +231,30 @@ fn the_crossing_check_reports_edges_that_cross() {
         1
     );
 }
+
+#[test]
+fn a_kinematic_particle_driven_into_a_pile_against_the_floor_is_reported_at_once() {
+    // A pinned particle moving down at 2 m/s, forever, onto a strand lying on the
+    // floor: nothing can stop it, so the collision cannot be resolved. The step says so
+    // with the particles involved, and the crossing check names the crossed edges.
+    let mut app = checked_app();
+    spawn_box(&mut app);
+    app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
+    StrandBuilder::line(DVec2::new(0.3, 0.006), DVec2::X, 21, 0.02)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let driven = app
+        .world_mut()
+        .spawn((
+            Particle,
+            Position(DVec2::new(0.5, 0.1)),
+            Velocity(DVec2::new(0.0, -2.0)),
+            Pinned,
+        ))
+        .id();
+    ticks(&mut app, 10);
+    let metrics = app.world().resource::<StrandMetrics>();
+    let unresolved = metrics.last_unresolved.expect("an unresolved collision");
+    assert!(unresolved.particles.contains(&driven), "{unresolved:?}");
+    assert!(metrics.unresolved_collisions > 0);
+}

@@ -1,20 +1,23 @@
 //! # bevy_strands_app
 //!
 //! Everything around the `bevy_strands` library that a game does not need: scenario
-//! files ([`scenario`], [`spawn`]), the demo factories and the furry creature
-//! ([`scenes`]), the headless runner and its report ([`runner`], [`report`]), pictures
+//! files ([`scenario`], [`spawn`], the [`builtin`] ones), the demo factories and the furry creature
+//! ([`scenes`]), the headless runner, its report and its snapshots ([`runner`],
+//! [`report`], [`snapshot`]), pictures
 //! of runs ([`export`]), the windowed demos (feature `render`, [`window`]), and the
 //! fixtures the tests and benchmarks share ([`fixtures`]). The `strands` binary is a
 //! thin command line over [`runner::run`].
 
 #![warn(missing_docs)]
 
+pub mod builtin;
 pub mod export;
 pub mod fixtures;
 pub mod report;
 pub mod runner;
 pub mod scenario;
 pub mod scenes;
+pub mod snapshot;
 pub mod spawn;
 #[cfg(feature = "render")]
 pub mod window;

@@ -1,6 +1,54 @@
 //! The run report: one JSON object, or a readable table.
 
+use bevy_strands::metrics::CrossingEvent;
+use bevy_strands::world::topology::Topology;
 use serde::Serialize;
+
+/// The first step end with crossed edges, told in terms a reader can find again.
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct CrossingReport {
+    /// The step that ended with the crossing.
+    pub step: u64,
+    /// Simulated time at its end.
+    pub time: f64,
+    /// Edge pairs crossed at that step end.
+    pub pairs: usize,
+    /// The two edges of the first pair: the strand (by creation order, and entity), the
+    /// edge along it, and its particles with their positions.
+    pub edges: Vec<String>,
+}
+
+impl CrossingReport {
+    /// Describe `event`, numbering strands by their creation order in `topology`.
+    pub fn describe(event: &CrossingEvent, topology: &Topology) -> Self {
+        let mut order: Vec<u32> = topology
+            .strands
+            .iter()
+            .map(|s| s.entity.index_u32())
+            .collect();
+        order.sort_unstable();
+        let edges = event
+            .edges
+            .iter()
+            .map(|e| {
+                let rank = order
+                    .binary_search(&e.strand.index_u32())
+                    .map_or("?".to_string(), |r| r.to_string());
+                let [p, q] = e.positions;
+                format!(
+                    "strand {rank} ({}) edge {}: particle {} at ({:.6}, {:.6}) to particle {} at ({:.6}, {:.6})",
+                    e.strand, e.edge, e.particles[0], p.x, p.y, e.particles[1], q.x, q.y
+                )
+            })
+            .collect();
+        Self {
+            step: event.step,
+            time: event.time,
+            pairs: event.pairs,
+            edges,
+        }
+    }
+}
 
 /// Constraint islands by kind and by the solver that took them.
 #[derive(Serialize, Clone, Debug, Default, PartialEq)]
@@ -46,6 +94,8 @@ pub struct Report {
     pub max_rel_length_error_free: f64,
     /// Step ends at which two edges sharing no particle intersected; null if unchecked.
     pub edge_crossings: Option<u64>,
+    /// The first of those, with its edges; null if none (or unchecked).
+    pub first_crossing: Option<CrossingReport>,
     /// Collision impulses applied.
     pub collisions: u64,
     /// Steps that needed the collision fail-safe.
@@ -154,6 +204,15 @@ impl Report {
         let mut out = String::new();
         for (key, value) in rows {
             out.push_str(&format!("{key:<width$}  {value}\n"));
+        }
+        if let Some(crossing) = &self.first_crossing {
+            out.push_str(&format!(
+                "first crossing: step {}, t = {:.6} s, {} pair(s)\n",
+                crossing.step, crossing.time, crossing.pairs
+            ));
+            for edge in &crossing.edges {
+                out.push_str(&format!("  {edge}\n"));
+            }
         }
         for note in &self.notes {
             out.push_str(&format!("note: {note}\n"));

@@ -13,12 +13,16 @@ use bevy_strands::constraints::projection::ConstraintDirection;
 use bevy_strands::metrics::LengthErrorHistory;
 use bevy_strands::prelude::*;
 
+use crate::builtin::{builtin, builtin_names};
 use crate::export::plot::plot_length_error;
 use crate::export::{ExportError, FrameSettings, Recorder};
-use crate::report::{IslandReport, Report};
+use crate::report::{CrossingReport, IslandReport, Report};
 use crate::scenario::{Scenario, ScenarioError};
-use crate::scenes::{ScenesPlugin, builtin, builtin_names};
+use crate::scenes::ScenesPlugin;
+use crate::scenes::spaghetti_factory::SpaghettiFactory;
+use crate::snapshot::{RunSnapshot, RunSnapshotError};
 use crate::spawn::spawn_scenario;
+use bevy_strands::world::snapshot::SnapshotError;
 
 /// What to run, and the command line's overrides of the scene.
 #[derive(Clone, Debug, Default)]
@@ -57,6 +61,14 @@ pub struct RunOptions {
     pub plot: Option<PathBuf>,
     /// Frame size and rate of `gif` and `frames`.
     pub frame_settings: FrameSettings,
+    /// Write a snapshot at the end of the first tick at or after this simulated time...
+    pub snapshot_at: Option<f64>,
+    /// ...to this file.
+    pub snapshot: Option<PathBuf>,
+    /// Continue the run saved in this snapshot instead of starting the scenario.
+    pub from: Option<PathBuf>,
+    /// End the run at the first step that ends with crossed edges.
+    pub stop_on_crossing: bool,
 }
 
 /// Why a run could not start or finish.
@@ -68,6 +80,17 @@ pub enum RunError {
     /// The scenario is invalid.
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// A snapshot could not be written or read.
+    #[error(transparent)]
+    Snapshot(#[from] RunSnapshotError),
+    /// A snapshot could not be restored.
+    #[error("{path}: {source}")]
+    Restore {
+        /// The snapshot file.
+        path: String,
+        /// What is wrong.
+        source: SnapshotError,
+    },
     /// No built-in scenario has that name.
     #[error("unknown scenario '{name}'; valid scenarios: {valid}")]
     UnknownScenario {
@@ -80,7 +103,7 @@ pub enum RunError {
 
 /// The scenario the options describe, overrides applied and validated.
 pub fn load_scenario(options: &RunOptions) -> Result<Scenario, RunError> {
-    let mut scenario = match &options.scene_file {
+    let scenario = match &options.scene_file {
         Some(path) => Scenario::load(path)?,
         None => builtin(&options.scenario)
             .ok_or_else(|| RunError::UnknownScenario {
@@ -89,6 +112,11 @@ pub fn load_scenario(options: &RunOptions) -> Result<Scenario, RunError> {
             })?
             .scenario()?,
     };
+    apply_overrides(scenario, options)
+}
+
+/// The command line's overrides applied to `scenario`, validated.
+fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scenario, RunError> {
     let command_line = |item: &str, problem: String| {
         RunError::Scenario(ScenarioError::new("command line", item, problem))
     };
@@ -128,6 +156,20 @@ pub fn load_scenario(options: &RunOptions) -> Result<Scenario, RunError> {
         scale.strands = options.strands.unwrap_or(scale.strands);
         scale.particles = options.particles.unwrap_or(scale.particles);
     }
+    if let Some(at) = options.snapshot_at
+        && !(at.is_finite() && at >= 0.0)
+    {
+        return Err(command_line(
+            "--snapshot-at",
+            format!("{at} must be a simulated time, zero or positive"),
+        ));
+    }
+    if options.snapshot_at.is_some() != options.snapshot.is_some() {
+        return Err(command_line(
+            "--snapshot-at/--snapshot",
+            "give both: the time and the file".into(),
+        ));
+    }
     scenario.validate("command line")?;
     Ok(scenario)
 }
@@ -143,15 +185,53 @@ pub fn headless_app(scenario: &Scenario) -> Result<App, RunError> {
     Ok(app)
 }
 
-/// Run the scene for its duration and report. `progress` is told the fraction done
-/// after every tick.
+/// An app with the simulation driven by hand and the run saved in `snapshot` restored.
+pub fn restored_app(snapshot: &RunSnapshot, path: &str) -> Result<App, RunError> {
+    let mut app = App::new();
+    app.add_plugins((StrandsPlugin::manual(), ScenesPlugin));
+    app.finish();
+    app.cleanup();
+    snapshot
+        .restore(app.world_mut())
+        .map_err(|source| RunError::Restore {
+            path: path.to_string(),
+            source,
+        })?;
+    Ok(app)
+}
+
+/// Run the scenario until its duration (from its start, or from a snapshot) and report.
+/// `progress` is told the fraction done after every tick.
 pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report, RunError> {
-    let scene = load_scenario(options)?;
-    let mut app = headless_app(&scene)?;
+    let (scene, mut app) = match &options.from {
+        Some(path) => {
+            let mut snapshot = RunSnapshot::load(path)?;
+            snapshot.scenario = apply_overrides(snapshot.scenario, options)?;
+            let app = restored_app(&snapshot, &path.display().to_string())?;
+            (snapshot.scenario, app)
+        }
+        None => {
+            let scene = load_scenario(options)?;
+            let app = headless_app(&scene)?;
+            (scene, app)
+        }
+    };
     let world = app.world_mut();
     if options.check_crossings {
-        world.resource_mut::<StrandMetrics>().edge_crossings = Some(0);
+        let mut metrics = world.resource_mut::<StrandMetrics>();
+        metrics.edge_crossings.get_or_insert(0);
     }
+    let mut notes = Vec::new();
+    if let Some(path) = &options.from {
+        let clock = world.resource::<SimulationClock>();
+        notes.push(format!(
+            "continued from {} at step {} (t = {:.4} s)",
+            path.display(),
+            clock.steps,
+            clock.time
+        ));
+    }
+    let mut snapshot_due = options.snapshot_at.zip(options.snapshot.clone());
     if options.plot.is_some() {
         world.init_resource::<LengthErrorHistory>();
     }
@@ -186,8 +266,39 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         if let Some(recorder) = &mut recorder {
             recorder.capture_if_due(world)?;
         }
+        let clock = *world.resource::<SimulationClock>();
+        if let Some((at, path)) = &snapshot_due
+            && clock.time + 1e-9 * scene.step.dt >= *at
+        {
+            RunSnapshot::capture(world, &scene).save(path)?;
+            notes.push(format!(
+                "snapshot written to {} at step {} (t = {:.4} s)",
+                path.display(),
+                clock.steps,
+                clock.time
+            ));
+            snapshot_due = None;
+        }
+        if options.stop_on_crossing && world.resource::<StrandMetrics>().first_crossing.is_some() {
+            notes.push(format!(
+                "stopped at the first crossing (step {}, t = {:.4} s)",
+                clock.steps, clock.time
+            ));
+            break;
+        }
+    }
+    let blocked: u64 = world
+        .query::<&SpaghettiFactory>()
+        .iter(world)
+        .map(|f| f.progress.blocked_ticks)
+        .sum();
+    if blocked > 0 {
+        notes.push(format!(
+            "the spaghetti factory's inlet was blocked for {blocked} ticks: its rollers stood still"
+        ));
     }
     let mut report = report(world, &scene, wall_seconds, particle_steps);
+    report.notes.splice(0..0, notes);
     if let Some(recorder) = recorder {
         let frames = recorder.finish()?;
         for (kind, path) in [("GIF", &options.gif), ("PNG frames", &options.frames)] {
@@ -256,12 +367,19 @@ fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u6
     if metrics.edge_crossings.is_none() {
         notes.push("edge crossings were not checked (--no-check)".to_string());
     }
-    if metrics.unresolved_collisions > 0 {
+    if let Some(last) = &metrics.last_unresolved {
         notes.push(format!(
-            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other)",
-            metrics.unresolved_collisions
+            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other); the latest at step {}: point {} against the edge {}–{}",
+            metrics.unresolved_collisions,
+            last.step,
+            last.particles[0],
+            last.particles[1],
+            last.particles[2]
         ));
     }
+    let first_crossing = metrics
+        .first_crossing
+        .map(|event| CrossingReport::describe(&event, world.resource::<Topology>()));
     let input_problems = world
         .resource::<InputProblems>()
         .entries
@@ -281,6 +399,7 @@ fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u6
         max_rel_length_error: metrics.max_rel_length_error,
         max_rel_length_error_free: metrics.max_rel_length_error_free,
         edge_crossings: metrics.edge_crossings,
+        first_crossing,
         collisions: metrics.collisions,
         failsafe_steps: metrics.failsafe_steps,
         projection_iterations_mean: metrics.projection.mean(),

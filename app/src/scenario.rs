@@ -17,6 +17,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::export::raster::View;
+use crate::scenes::furry_creature::FurryCreatureSpec;
+use crate::scenes::meatball_factory::MeatballFactorySpec;
+use crate::scenes::spaghetti_factory::SpaghettiFactorySpec;
 
 /// A problem with a scenario file: which file, which item in it, and what is wrong.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -101,61 +104,6 @@ pub struct Scenario {
     pub scale: Option<ScaleSpec>,
 }
 
-/// The meatball factory (see [`MeatballFactory`](crate::scenes::meatball_factory::MeatballFactory)).
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct MeatballFactorySpec {
-    /// Seconds between drops.
-    pub interval: f64,
-    /// Simulated time of the first drop.
-    #[serde(default)]
-    pub start: f64,
-    /// Side of the triangles.
-    pub side: f64,
-    /// Height the triangles' centres are dropped from.
-    pub height: f64,
-    /// x of the first drop.
-    pub first_x: f64,
-    /// x step between drops.
-    pub step_x: f64,
-    /// Drops past this x wrap around by whole steps...
-    pub wrap_x: f64,
-    /// ...to the lowest drop point at or above this x.
-    pub low_x: f64,
-    /// Initial falling speed.
-    pub speed: f64,
-    /// Spin (rad/s), alternating in sign from drop to drop.
-    pub spin: f64,
-    /// Triangles at most.
-    pub max: usize,
-    /// Mass of each particle.
-    #[serde(default = "one")]
-    pub mass: f64,
-}
-
-/// The furry creature (see [`FurryCreature`](crate::scenes::furry_creature::FurryCreature)).
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct FurryCreatureSpec {
-    /// Centre of the body's circular path.
-    pub centre: [f64; 2],
-    /// Radius of the path.
-    pub path_radius: f64,
-    /// Seconds per turn of the path.
-    pub period: f64,
-    /// Radius of the body.
-    pub body_radius: f64,
-    /// Hairs, evenly spaced around the rim.
-    pub hairs: usize,
-    /// Particles per hair.
-    pub particles_per_hair: usize,
-    /// Rest spacing of the hairs' particles.
-    pub spacing: f64,
-    /// Mass of each particle.
-    #[serde(default = "one")]
-    pub mass: f64,
-}
-
 /// The scale scenario's strands.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -166,33 +114,6 @@ pub struct ScaleSpec {
     pub particles: usize,
     /// Rest spacing.
     pub spacing: f64,
-}
-
-/// The spaghetti factory (see [`SpaghettiFactory`](crate::scenes::spaghetti_factory::SpaghettiFactory)).
-#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct SpaghettiFactorySpec {
-    /// Where particles appear.
-    pub inlet: [f64; 2],
-    /// Their velocity there.
-    pub velocity: [f64; 2],
-    /// Seconds between particles.
-    pub interval: f64,
-    /// Particles per strand.
-    pub particles_per_strand: usize,
-    /// Newest particles held at the inlet velocity.
-    #[serde(default = "two")]
-    pub held: usize,
-    /// Mass of each particle.
-    #[serde(default = "one")]
-    pub mass: f64,
-    /// Stop after this many strands.
-    #[serde(default)]
-    pub max_strands: Option<usize>,
-}
-
-fn two() -> usize {
-    2
 }
 
 fn one() -> f64 {
@@ -443,11 +364,11 @@ impl Scenario {
         self.validate_links().map_err(|(item, p)| fail(&item, p))?;
         if let Some(f) = &self.spaghetti_factory {
             let at = number("spaghetti_factory");
-            finite_vector("inlet", vec2(f.inlet)).map_err(at)?;
-            finite_vector("velocity", vec2(f.velocity)).map_err(at)?;
+            finite_vector("inlet", f.inlet).map_err(at)?;
+            finite_vector("velocity", f.velocity).map_err(at)?;
             positive("interval", f.interval).map_err(at)?;
             positive("mass", f.mass).map_err(at)?;
-            if f.velocity[0] == 0.0 && f.velocity[1] == 0.0 {
+            if f.velocity == DVec2::ZERO {
                 return Err(fail(
                     "spaghetti_factory.velocity",
                     "must not be zero: it sets the strands' rest spacing".into(),
@@ -485,7 +406,7 @@ impl Scenario {
         }
         if let Some(f) = &self.furry_creature {
             let at = number("furry_creature");
-            finite_vector("centre", vec2(f.centre)).map_err(at)?;
+            finite_vector("centre", f.centre).map_err(at)?;
             for (field, value) in [
                 ("period", f.period),
                 ("body_radius", f.body_radius),

@@ -6,18 +6,23 @@ use bevy_strands::prelude::*;
 use bevy_strands::world::edit::create_edge;
 
 use crate::scenario::{Scenario, ScenarioError, vec2};
-use crate::scenes::furry_creature::{FurryCreature, spawn_furry_creature};
+use crate::scenes::furry_creature::spawn_furry_creature;
 use crate::scenes::meatball_factory::MeatballFactory;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
 
-/// Configure the world's resources from the scenario and spawn its walls, strands and
-/// particles. The scenario must have passed [`Scenario::validate`].
+/// Set the world's configuration resources to the scenario's.
+pub fn configure(world: &mut World, scenario: &Scenario) {
+    world.insert_resource(scenario.step.clone());
+    world.insert_resource(scenario.constraints.clone());
+    world.insert_resource(scenario.collisions.clone());
+    world.insert_resource(scenario.contact.clone());
+}
+
+/// Configure the world from the scenario and spawn its walls, strands, particles and
+/// factories. The scenario must have passed [`Scenario::validate`].
 pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), ScenarioError> {
     let fail = |item: String, problem: String| ScenarioError::new(&scene.name, item, problem);
-    world.insert_resource(scene.step.clone());
-    world.insert_resource(scene.constraints.clone());
-    world.insert_resource(scene.collisions.clone());
-    world.insert_resource(scene.contact.clone());
+    configure(world, scene);
 
     if let Some(scale) = &scene.scale {
         let container = scale.container();
@@ -66,46 +71,14 @@ pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), Scenari
         let (a, b) = (particle(link.from)?, particle(link.to)?);
         create_edge(world, a, b).map_err(|e| fail(format!("links[{i}]"), e.to_string()))?;
     }
-    if let Some(f) = &scene.spaghetti_factory {
-        let mut factory = SpaghettiFactory::new(
-            vec2(f.inlet),
-            vec2(f.velocity),
-            f.interval,
-            f.particles_per_strand,
-        );
-        factory.held = f.held;
-        factory.mass = f.mass;
-        factory.max_strands = f.max_strands;
-        world.spawn(factory);
+    if let Some(spec) = scene.spaghetti_factory {
+        world.spawn(SpaghettiFactory::new(spec));
     }
-    if let Some(m) = &scene.meatball_factory {
-        world.spawn(MeatballFactory {
-            interval: m.interval,
-            side: m.side,
-            height: m.height,
-            drop_x: m.first_x,
-            step_x: m.step_x,
-            wrap_x: m.wrap_x,
-            low_x: m.low_x,
-            speed: m.speed,
-            spin: m.spin,
-            max: m.max,
-            mass: m.mass,
-            next_drop: m.start,
-            dropped: 0,
-            skipped: 0,
-        });
+    if let Some(spec) = scene.meatball_factory {
+        world.spawn(MeatballFactory::new(spec));
     }
-    if let Some(f) = &scene.furry_creature {
-        let creature = FurryCreature::new(vec2(f.centre), f.path_radius, f.period, f.body_radius);
-        spawn_furry_creature(
-            world,
-            creature,
-            f.hairs,
-            f.particles_per_hair,
-            f.spacing,
-            f.mass,
-        );
+    if let Some(spec) = scene.furry_creature {
+        spawn_furry_creature(world, spec);
     }
     for particle in &scene.particles {
         let mut entity = world.spawn((

@@ -1,9 +1,9 @@
 //! Scenario files: the built-in scenarios load, and every kind of bad input is refused with
 //! a message naming the file, the item and the problem.
 
+use bevy_strands_app::builtin::BUILTIN_SCENES;
 use bevy_strands_app::runner::{RunError, RunOptions, load_scenario};
 use bevy_strands_app::scenario::Scenario;
-use bevy_strands_app::scenes::BUILTIN_SCENES;
 
 const GOOD: &str = r#"(
     name: "test",

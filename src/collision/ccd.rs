@@ -21,6 +21,15 @@ pub struct PointEdgeHit {
     pub alpha: f64,
     /// Unit normal of the edge at the time of impact, on the side the point came from.
     pub normal: DVec2,
+    /// Whether the point ends the step on the other side of the edge's line, by the
+    /// orientation test of the crossing check on the same end positions.
+    pub crosses: bool,
+}
+
+/// Orientation of `p` relative to the directed line q→r: the crossing check's test
+/// ([`segments_intersect`](crate::model::geometry::segments_intersect)), term for term.
+fn side(p: DVec2, q: DVec2, r: DVec2) -> f64 {
+    (r - q).perp_dot(p - q)
 }
 
 /// Relative tolerance of the degenerate-case tests and of α's range.
@@ -56,16 +65,15 @@ pub fn point_edge_time_of_impact(
             // Collinear throughout: the point slides along the edge's line and hits
             // the edge where it reaches an endpoint, or at once if already on it.
             return collinear_contact(p, dp, q, dq, r, dr);
-        } else {
-            return None; // parallel motion, never collinear
         }
+        // Otherwise the motion is parallel to the line as far as the coefficients
+        // can tell; the sign test below still catches a crossing at smaller scales.
     } else {
         let discriminant = linear * linear - 4.0 * quadratic * constant;
         if discriminant < 0.0 {
-            if discriminant < -EPS * (linear * linear).max(tiny * tiny) {
-                return None;
+            if discriminant >= -EPS * (linear * linear).max(tiny * tiny) {
+                roots[0] = -linear / (2.0 * quadratic); // grazing: a double root
             }
-            roots[0] = -linear / (2.0 * quadratic); // grazing: a double root
         } else {
             // The stable pair of roots: no cancellation in either.
             let s = -0.5 * (linear + linear.signum() * discriminant.sqrt());
@@ -75,10 +83,38 @@ pub fn point_edge_time_of_impact(
             }
         }
     }
-    roots
+    // The sides at the start and at the end of the step, computed as the crossing check
+    // computes them on the positions the Integrate stage will produce (`x + d`): a
+    // point that ends across the line has crossed it, whatever the tolerances above
+    // made of the motion, and it is reported as crossing exactly when the check would
+    // count it.
+    let (start, end) = (side(p, q, r), side(p + dp, q + dq, r + dr));
+    let crosses = (start > 0.0 && end <= 0.0) || (start < 0.0 && end >= 0.0);
+    let found = roots
         .into_iter()
         .filter(|t| t.is_finite() && *t >= -EPS && *t <= 1.0 + EPS)
-        .find_map(|t| at(t.clamp(0.0, 1.0)))
+        .find_map(|t| at(t.clamp(0.0, 1.0)));
+    if let Some(hit) = found {
+        return Some(PointEdgeHit { crosses, ..hit });
+    }
+    if crosses {
+        // Find where by bisection on the sign of the same orientation along the motion.
+        let along = |t: f64| side(p + t * dp, q + t * dq, r + t * dr);
+        let (mut low, mut high) = (0.0, 1.0);
+        for _ in 0..64 {
+            let middle = 0.5 * (low + high);
+            if (along(middle) > 0.0) == (start > 0.0) {
+                low = middle;
+            } else {
+                high = middle;
+            }
+        }
+        return at(high).map(|hit| PointEdgeHit {
+            crosses: true,
+            ..hit
+        });
+    }
+    None
 }
 
 /// The contact at time `t`, if p then lies on the edge (α in [0, 1] up to tolerance).
@@ -111,6 +147,7 @@ fn hit_at(
         time: t,
         alpha,
         normal: orient_normal(normal, p, q, r, dp, dq, dr, alpha),
+        crosses: false,
     })
 }
 
@@ -127,11 +164,13 @@ fn orient_normal(
     dr: DVec2,
     alpha: f64,
 ) -> DVec2 {
-    let start_side = normal.dot(p - q.lerp(r, alpha));
+    // Differences from q, which lies close to p, carry no rounding of the coordinates
+    // themselves: the side is resolved down to gaps far below the pair's size.
+    let start_side = normal.dot((p - q) - alpha * (r - q));
     let side = if start_side != 0.0 {
         start_side
     } else {
-        -normal.dot(dp - dq.lerp(dr, alpha))
+        -normal.dot((dp - dq) - alpha * (dr - dq))
     };
     if side < 0.0 { -normal } else { normal }
 }
@@ -234,6 +273,44 @@ mod tests {
             DVec2::new(-0.2, 1.0),
         );
         assert!(sweep.is_some());
+    }
+
+    #[test]
+    fn a_crossing_far_below_the_pair_size_is_found() {
+        // The step of the 100 s spaghetti factory run at which two edges first crossed
+        // (step 201 466): a point resting 3.5e-14 off an edge's line, moving with it
+        // to 1e-14 per step. Every coefficient of the collinearity quadratic is then
+        // of the order of the degenerate-case tolerance; dropping the quadratic term
+        // moved the root from 0.93 (inside the step) to 1.06, and the crossing was
+        // missed. The end orientation, computed as the crossing check computes it,
+        // has the other sign than at the start.
+        let p = DVec2::new(0.865400132384969, 0.08193518772812437);
+        let dp = DVec2::new(6.40242010584905e-7, 2.0144803076899034e-7);
+        let q = DVec2::new(0.9067516529516643, 0.07714971904176424);
+        let dq = DVec2::new(5.597952890183997e-7, 2.1341995835763488e-7);
+        let r = DVec2::new(0.8570831428427685, 0.08289768420882919);
+        let dr = DVec2::new(5.594301372373597e-7, 2.1026472281696286e-7);
+        let found = hit(p, dp, q, dq, r, dr).expect("the crossing is found");
+        assert!(found.crosses, "{found:?}");
+        assert!((found.time - 0.928).abs() < 1e-3, "{found:?}");
+        assert!((found.alpha - 0.8326).abs() < 1e-3, "{found:?}");
+        // The normal points to the side the point came from.
+        assert!(found.normal.dot(p - q) > 0.0, "{found:?}");
+        let end = |x: DVec2, d: DVec2| x + d;
+        let side = |x: DVec2, a: DVec2, b: DVec2| (b - a).perp_dot(x - a);
+        assert!(side(p, q, r) * side(end(p, dp), end(q, dq), end(r, dr)) < 0.0);
+
+        // Synthetic cases at the same scale: a point 3.5e-14 or 1e-15 off the line,
+        // moving across it with the edge carried along.
+        let n = (r - q).perp().normalize();
+        let common = DVec2::new(1.7e-3, 6.0e-4) / 3000.0;
+        for (offset, drift) in [(3.5e-14, -7e-14), (-3.5e-14, 7e-14), (1e-15, -3e-15)] {
+            let p = q + 0.8325 * (r - q) + offset * n;
+            let found = hit(p, common + drift * n, q, common, r, common)
+                .unwrap_or_else(|| panic!("offset {offset:e}, drift {drift:e}: missed"));
+            assert!((found.alpha - 0.8325).abs() < 1e-6, "{found:?}");
+            assert!(found.normal.dot(n) * offset > 0.0, "{found:?}");
+        }
     }
 
     /// Brute force: sample the motion finely and report the first sample interval in

@@ -10,6 +10,15 @@ use super::broad_phase::{BroadPhase, BroadPhaseMethod};
 use crate::model::Edge;
 use crate::model::geometry::segments_intersect;
 
+/// How many edge pairs cross, and the first of them in the broad phase's order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Crossings {
+    /// Pairs of edges sharing no particle that intersect.
+    pub pairs: usize,
+    /// The first such pair (edge indices), if any.
+    pub first: Option<(u32, u32)>,
+}
+
 /// Edge pairs that share no particle and intersect at `position`. `pairs` is scratch.
 pub fn count_crossings(
     edges: &[Edge],
@@ -17,7 +26,7 @@ pub fn count_crossings(
     broad: &mut BroadPhase,
     method: BroadPhaseMethod,
     pairs: &mut Vec<(u32, u32)>,
-) -> usize {
+) -> Crossings {
     broad.build(edges, position, None, 0.0);
     pairs.clear();
     broad.edge_edge_pairs(
@@ -25,16 +34,18 @@ pub fn count_crossings(
         |j, k| !edges[j as usize].shares_particle(&edges[k as usize]),
         pairs,
     );
-    pairs
-        .iter()
-        .filter(|&&(j, k)| {
-            let (e, f) = (&edges[j as usize], &edges[k as usize]);
-            segments_intersect(
-                position[e.a as usize],
-                position[e.b as usize],
-                position[f.a as usize],
-                position[f.b as usize],
-            )
-        })
-        .count()
+    let mut crossings = Crossings::default();
+    for &(j, k) in pairs.iter() {
+        let (e, f) = (&edges[j as usize], &edges[k as usize]);
+        if segments_intersect(
+            position[e.a as usize],
+            position[e.b as usize],
+            position[f.a as usize],
+            position[f.b as usize],
+        ) {
+            crossings.pairs += 1;
+            crossings.first.get_or_insert((j, k));
+        }
+    }
+    crossings
 }

@@ -15,7 +15,7 @@ use super::ccd::point_edge_time_of_impact;
 use super::failsafe::ImpactZones;
 use super::response::{collision_normal_change, contact_change, repulsion_normal_change};
 use crate::model::geometry::closest_on_segment;
-use crate::model::motion::{displacement, displacements, end_of_step};
+use crate::model::motion::{displacement, displacements};
 use crate::model::{Edge, PointEdgePair};
 
 /// The collision settings the passes use.
@@ -29,6 +29,8 @@ pub struct ImpulseSettings {
     pub restitution: f64,
     /// Detection passes before the fail-safe.
     pub max_iterations: u32,
+    /// The gap a collision leaves, as a fraction of the thickness.
+    pub separation: f64,
     /// How candidate pairs are found.
     pub broad_phase: BroadPhaseMethod,
 }
@@ -75,6 +77,18 @@ impl ImpulseScratch {
     }
 }
 
+/// A pair to push apart: the point against the edge at the contact coordinate, along
+/// the normal towards the point's side.
+#[derive(Clone, Copy, Debug)]
+struct Collision {
+    pair: PointEdgePair,
+    normal: DVec2,
+    /// Relative normal velocity now (negative: approaching).
+    normal_velocity: f64,
+    /// Gap along the normal at the start of the step.
+    start_gap: f64,
+}
+
 /// How one step's collision processing went.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CollisionOutcome {
@@ -85,6 +99,8 @@ pub struct CollisionOutcome {
     /// Collisions the fail-safe could not resolve (kinematic particles driven into
     /// each other); 0 in every sound scene.
     pub unresolved: usize,
+    /// The first of them: the point and the edge's two particles (packed indices).
+    pub first_unresolved: Option<[u32; 3]>,
 }
 
 impl CollisionOutcome {
@@ -93,6 +109,7 @@ impl CollisionOutcome {
         self.impulses += other.impulses;
         self.failsafe |= other.failsafe;
         self.unresolved += other.unresolved;
+        self.first_unresolved = self.first_unresolved.or(other.first_unresolved);
     }
 }
 
@@ -154,12 +171,6 @@ impl Collider<'_> {
             r: e.b as usize,
             alpha,
         }
-    }
-
-    /// A relative speed that moves a pair by a billionth of the thickness per step:
-    /// below it, an approach is round-off, not a collision.
-    fn negligible_speed(&self) -> f64 {
-        1e-9 * self.settings.thickness.max(1e-9) / self.dt
     }
 
     /// Apply a relative-velocity change and record the contact.
@@ -234,45 +245,66 @@ impl Collider<'_> {
     }
 
     /// One detection pass over the current pairs; impulses are applied as found, each
-    /// test using the velocities the earlier impulses left.
+    /// test using the velocities the earlier impulses left. A collision leaves the
+    /// pair ending the step at least the separation apart (or bouncing with the
+    /// restitution, if that is more).
     fn collision_pass(&mut self) -> u64 {
         let mut impulses = 0;
+        let separation = self.settings.separation * self.settings.thickness;
         for slot in 0..self.scratch.pairs.len() {
             let (p, k) = self.scratch.pairs[slot];
-            let Some((pair, normal, normal_velocity)) = self.approaching_hit(p, k) else {
+            let Some(c) = self.collision(p, k) else {
                 continue;
             };
-            let change = collision_normal_change(normal_velocity, self.settings.restitution);
-            let relative = pair.relative_velocity(self.velocity);
-            let delta = contact_change(relative, normal, change, self.settings.friction);
-            impulses += u64::from(self.respond(pair, k, delta, normal));
+            let change = collision_normal_change(
+                c.normal_velocity,
+                c.start_gap,
+                separation,
+                self.settings.restitution,
+                self.dt,
+            );
+            let relative = c.pair.relative_velocity(self.velocity);
+            let delta = contact_change(relative, c.normal, change, self.settings.friction);
+            impulses += u64::from(self.respond(c.pair, k, delta, c.normal));
         }
         impulses
     }
 
-    /// The contact of point `p` with edge `k` over the step, if they meet approaching.
-    fn approaching_hit(&self, p: u32, k: u32) -> Option<(PointEdgePair, DVec2, f64)> {
+    /// Whether point `p` and edge `k` must be pushed apart this pass: they meet during
+    /// the step approaching, or the point ends across the edge's line (however slowly
+    /// it got there).
+    fn collision(&self, p: u32, k: u32) -> Option<Collision> {
         let e = &self.edges[k as usize];
         let (a, b, i) = (e.a as usize, e.b as usize, p as usize);
-        let dt = self.dt;
+        let (x, v, dt) = (self.position, &*self.velocity, self.dt);
         let hit = point_edge_time_of_impact(
-            self.position[i],
-            displacement(self.velocity[i], dt),
-            self.position[a],
-            displacement(self.velocity[a], dt),
-            self.position[b],
-            displacement(self.velocity[b], dt),
+            x[i],
+            displacement(v[i], dt),
+            x[a],
+            displacement(v[a], dt),
+            x[b],
+            displacement(v[b], dt),
         )?;
-        let pair = self.pair(p, k, hit.alpha);
-        let normal_velocity = hit.normal.dot(pair.relative_velocity(self.velocity));
-        // Touching while moving apart (or not at all) is no collision; creeping through
-        // the edge, however slowly, is one.
-        let approaching = normal_velocity < -self.negligible_speed();
-        let creeping = !approaching && normal_velocity < 0.0 && {
-            let end = |x: usize| end_of_step(self.position[x], self.velocity[x], dt);
-            hit.normal.dot(end(i) - end(a).lerp(end(b), hit.alpha)) < 0.0
-        };
-        (approaching || creeping).then_some((pair, hit.normal, normal_velocity))
+        let collision = self.collision_at(p, k, hit.alpha, hit.normal);
+        (collision.normal_velocity < 0.0 || hit.crosses).then_some(collision)
+    }
+
+    /// Point `p` against edge `k` at `alpha` along `normal`: the pair, its relative
+    /// normal velocity and its gap along the normal at the start of the step.
+    fn collision_at(&self, p: u32, k: u32, alpha: f64, normal: DVec2) -> Collision {
+        let e = &self.edges[k as usize];
+        let x = self.position;
+        let pair = self.pair(p, k, alpha);
+        // Differences from the edge's first end, which lies close to the point, keep
+        // the gap exact to far below the coordinates' own rounding.
+        let (q, r) = (x[e.a as usize], x[e.b as usize]);
+        let start_gap = normal.dot((x[p as usize] - q) - alpha * (r - q));
+        Collision {
+            pair,
+            normal,
+            normal_velocity: normal.dot(pair.relative_velocity(self.velocity)),
+            start_gap,
+        }
     }
 
     /// Detection and impulses until a full pass finds no collision or the cap is hit;
@@ -293,6 +325,9 @@ impl Collider<'_> {
         }
         outcome.failsafe = true;
         outcome.unresolved = self.fail_safe();
+        outcome.first_unresolved = (outcome.unresolved > 0)
+            .then(|| self.scratch.hits.first().map(|&(p, q, r)| [p, q, r]))
+            .flatten();
         outcome
     }
 
@@ -306,7 +341,7 @@ impl Collider<'_> {
             self.scratch.hits.clear();
             for slot in 0..self.scratch.pairs.len() {
                 let (p, k) = self.scratch.pairs[slot];
-                if let Some((pair, ..)) = self.approaching_hit(p, k) {
+                if let Some(Collision { pair, .. }) = self.collision(p, k) {
                     self.scratch
                         .hits
                         .push((pair.p as u32, pair.q as u32, pair.r as u32));

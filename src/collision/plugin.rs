@@ -5,8 +5,9 @@ use bevy::prelude::*;
 use super::broad_phase::BroadPhase;
 use super::crossings::count_crossings;
 use super::impulses::{Collider, CollisionOutcome, ImpulseScratch, ImpulseSettings};
-use crate::metrics::{StrandMetrics, measure};
+use crate::metrics::{CrossedEdge, CrossingEvent, StrandMetrics, UnresolvedCollision, measure};
 use crate::schedule::{CollideSet, StepSet, StrandsStep};
+use crate::world::clock::SimulationClock;
 use crate::world::config::{CollisionConfig, StrandsConfig};
 use crate::world::state::ParticleState;
 use crate::world::topology::Topology;
@@ -52,6 +53,7 @@ impl CollisionConfig {
             friction: self.friction,
             restitution: self.restitution,
             max_iterations: self.max_iterations,
+            separation: self.separation,
             broad_phase: self.broad_phase,
         }
     }
@@ -145,10 +147,13 @@ pub fn impulses(
     scratch.outcome.impulses += proximity;
 }
 
-/// Account sub-stage: the step's collision figures into the metrics.
+/// Account sub-stage: the step's collision figures into the metrics. A collision left
+/// unresolved is logged with its particles at once.
 pub fn account_collisions(
     config: Res<CollisionConfig>,
     scratch: Res<CollisionScratch>,
+    state: Res<ParticleState>,
+    clock: Res<SimulationClock>,
     mut metrics: ResMut<StrandMetrics>,
 ) {
     if !config.enabled {
@@ -159,13 +164,32 @@ pub fn account_collisions(
     metrics.collisions_last_step = total.impulses;
     metrics.failsafe_steps += u64::from(total.failsafe);
     metrics.unresolved_collisions += total.unresolved as u64;
+    if let Some(particles) = total.first_unresolved {
+        let event = UnresolvedCollision {
+            step: clock.steps + 1,
+            particles: particles.map(|i| state.entity[i as usize]),
+            positions: particles.map(|i| state.position[i as usize]),
+        };
+        warn!(
+            "bevy_strands: step {}: {} collision(s) left unresolved, kinematic particles driven \
+             through each other; the first: point {} against the edge {}–{}",
+            event.step,
+            total.unresolved,
+            event.particles[0],
+            event.particles[1],
+            event.particles[2]
+        );
+        metrics.last_unresolved = Some(event);
+    }
 }
 
-/// The Measure stage's crossing check (checked mode only).
+/// The Measure stage's crossing check (checked mode only). The first crossing is
+/// recorded with its edges and logged as an error.
 pub fn check_crossings(
     config: Res<CollisionConfig>,
     topology: Res<Topology>,
     state: Res<ParticleState>,
+    clock: Res<SimulationClock>,
     mut scratch: ResMut<CollisionScratch>,
     mut metrics: ResMut<StrandMetrics>,
 ) {
@@ -184,6 +208,19 @@ pub fn check_crossings(
         config.broad_phase,
         crossing_pairs,
     );
-    metrics.crossing_pairs_last_step = crossings;
-    *metrics.edge_crossings.get_or_insert(0) += u64::from(crossings > 0);
+    metrics.crossing_pairs_last_step = crossings.pairs;
+    *metrics.edge_crossings.get_or_insert(0) += u64::from(crossings.pairs > 0);
+    if let (Some((j, k)), None) = (crossings.first, &metrics.first_crossing) {
+        let event = CrossingEvent {
+            step: clock.steps,
+            time: clock.time,
+            pairs: crossings.pairs,
+            edges: [j, k].map(|e| CrossedEdge::of(e as usize, &topology, &state)),
+        };
+        error!(
+            "bevy_strands: edges crossed at step {} (t = {:.6} s): {:?}",
+            event.step, event.time, event.edges
+        );
+        metrics.first_crossing = Some(event);
+    }
 }

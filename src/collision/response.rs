@@ -19,14 +19,18 @@ pub fn contact_change(relative: DVec2, n: DVec2, normal_change: f64, friction: f
     normal_change * n - slowdown * tangential
 }
 
-/// Normal velocity change for a collision found by continuous detection: stop the
-/// approach and bounce with restitution `e`.
-pub fn collision_normal_change(normal_velocity: f64, restitution: f64) -> f64 {
-    if normal_velocity < 0.0 {
-        -(1.0 + restitution) * normal_velocity
-    } else {
-        0.0
-    }
+/// Normal velocity change for a collision: relative normal velocity `vn`, gap along
+/// the normal at the start of the step `g0`. The pair leaves with at least the bounce
+/// of restitution `e`, and at least the velocity that ends the step `separation` apart
+/// (`g0 + dt vn' ≥ separation`): a pair that started apart may close in to the
+/// separation, one that started closer is pushed out to it. A contact is therefore
+/// never left touching, where rounding alone would decide its side. A gap below zero
+/// along the normal of the moment of contact (an edge that turned during the step) is
+/// taken as touching: the push out is never more than the separation.
+pub fn collision_normal_change(vn: f64, g0: f64, separation: f64, e: f64, dt: f64) -> f64 {
+    let bounce = if vn < 0.0 { -e * vn } else { vn };
+    let target = bounce.max((separation - g0.max(0.0)) / dt);
+    (target - vn).max(0.0)
 }
 
 /// Normal velocity change for a pair that would end the step closer than thickness
@@ -56,6 +60,23 @@ mod tests {
         // ...and slides, slowed by μ × the normal change, when above.
         let slide = contact_change(DVec2::new(2.0, -1.0), n, 1.0, 0.3);
         assert!((slide - DVec2::new(-0.3, 1.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn a_collision_leaves_the_pair_the_separation_apart() {
+        let (dt, separation) = (1.0 / 3000.0, 4e-4);
+        // Started well apart, approaching: stopped (inelastic), the gap kept.
+        let change = collision_normal_change(-2.0, 0.003, separation, 0.0, dt);
+        assert_eq!(change, 2.0);
+        // Started touching, creeping in: pushed out to end at the separation.
+        let (vn, g0) = (-1e-10, 1e-14);
+        let change = collision_normal_change(vn, g0, separation, 0.0, dt);
+        assert!((g0 + dt * (vn + change) - separation).abs() < 1e-15);
+        // Restitution bounces back when that is more.
+        let change = collision_normal_change(-2.0, 0.003, separation, 0.5, dt);
+        assert_eq!(change, 3.0);
+        // Already leaving fast enough: nothing.
+        assert_eq!(collision_normal_change(5.0, 0.0, separation, 0.0, dt), 0.0);
     }
 
     #[test]

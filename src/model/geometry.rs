@@ -42,6 +42,21 @@ pub fn closest_on_segment(p: DVec2, q: DVec2, r: DVec2) -> (f64, f64) {
     (alpha, p.distance(q + alpha * edge))
 }
 
+/// Distance between segments a–b and c–d (0 if they intersect).
+pub fn segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
+    if segments_intersect(a, b, c, d) {
+        return 0.0;
+    }
+    [
+        closest_on_segment(a, c, d).1,
+        closest_on_segment(b, c, d).1,
+        closest_on_segment(c, a, b).1,
+        closest_on_segment(d, a, b).1,
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min)
+}
+
 /// Orientation of c relative to the directed line a→b: positive to the left.
 fn orientation(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a)
@@ -80,6 +95,35 @@ mod tests {
         let tri = [DVec2::ZERO, DVec2::X, DVec2::new(0.5, 3f64.sqrt() / 2.0)];
         for a in turning_angles(&tri, true) {
             assert!((a - TAU / 3.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn segment_distance_agrees_with_sampling() {
+        let p = |x, y| DVec2::new(x, y);
+        let cases = [
+            (p(0.0, 0.0), p(1.0, 0.0), p(0.5, 0.3), p(0.5, 2.0), 0.3),
+            (p(0.0, 0.0), p(1.0, 0.0), p(0.5, -1.0), p(0.5, 1.0), 0.0),
+            (p(0.0, 0.0), p(1.0, 0.0), p(2.0, 0.0), p(3.0, 0.0), 1.0),
+            (
+                p(0.0, 0.0),
+                p(1.0, 1.0),
+                p(2.0, 0.0),
+                p(3.0, -1.0),
+                2f64.sqrt(),
+            ),
+        ];
+        for (a, b, c, d, expected) in cases {
+            let sampled = (0..=400)
+                .flat_map(|i| (0..=400).map(move |j| (i as f64 / 400.0, j as f64 / 400.0)))
+                .map(|(s, t)| a.lerp(b, s).distance(c.lerp(d, t)))
+                .fold(f64::INFINITY, f64::min);
+            let distance = segment_distance(a, b, c, d);
+            assert!(
+                (distance - expected).abs() < 1e-12,
+                "{distance} vs {expected}"
+            );
+            assert!(distance <= sampled + 1e-12 && sampled - distance < 5e-3);
         }
     }
 

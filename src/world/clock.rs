@@ -4,6 +4,7 @@ use bevy::prelude::*;
 
 /// Simulated time and steps taken.
 #[derive(Resource, Reflect, Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[reflect(Resource)]
 pub struct SimulationClock {
     /// Simulated seconds since start.

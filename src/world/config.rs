@@ -173,6 +173,11 @@ pub struct CollisionConfig {
     pub restitution: f64,
     /// Detection passes before the fail-safe.
     pub max_iterations: u32,
+    /// The gap a collision leaves between a point and an edge, as a fraction of the
+    /// thickness. The default, a millionth, is far above rounding (a point resting
+    /// within rounding of an edge's line has no reliable side) and far below anything
+    /// visible or any motion the cushion makes.
+    pub separation: f64,
     /// How candidate pairs are found.
     pub broad_phase: BroadPhaseMethod,
     /// Count edge crossings at the end of every step.
@@ -187,6 +192,7 @@ impl Default for CollisionConfig {
             friction: 0.3,
             restitution: 0.0,
             max_iterations: 10,
+            separation: 1e-6,
             broad_phase: BroadPhaseMethod::Grid,
             check_crossings: false,
         }
@@ -199,6 +205,7 @@ impl CollisionConfig {
         positive("thickness", self.thickness)?;
         non_negative("friction", self.friction)?;
         within("restitution", self.restitution, 0.0..=1.0)?;
+        within("separation", self.separation, 0.0..=1.0)?;
         at_least(
             "max_iterations",
             self.max_iterations as usize,

@@ -6,9 +6,9 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use bevy_strands::constraints::SolverKind;
+use bevy_strands_app::builtin::BUILTIN_SCENES;
 use bevy_strands_app::export::FrameSettings;
 use bevy_strands_app::runner::{RunOptions, run};
-use bevy_strands_app::scenes::BUILTIN_SCENES;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -33,8 +33,9 @@ enum Command {
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// Scenario name (see `strands list`).
-    scenario: String,
+    /// Scenario name (see `strands list`); not needed with --scene or --from.
+    #[arg(required_unless_present_any = ["scene", "from"])]
+    scenario: Option<String>,
     /// Run this scene file instead of the built-in scenario.
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
@@ -91,6 +92,19 @@ struct RunArgs {
     /// Write a plot of the largest relative length error over time (PNG).
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
+    /// Write a snapshot at the end of the first tick at or after this simulated time
+    /// (with --snapshot).
+    #[arg(long, value_name = "T", requires = "snapshot")]
+    snapshot_at: Option<f64>,
+    /// The snapshot file to write (with --snapshot-at).
+    #[arg(long, value_name = "FILE", requires = "snapshot_at")]
+    snapshot: Option<PathBuf>,
+    /// Continue the run saved in this snapshot; --seconds is then the time to run to.
+    #[arg(long, value_name = "FILE")]
+    from: Option<PathBuf>,
+    /// End the run at the first step that ends with crossed edges.
+    #[arg(long)]
+    stop_on_crossing: bool,
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -130,7 +144,7 @@ fn main() -> ExitCode {
         }
         Command::Run(args) => {
             let options = RunOptions {
-                scenario: args.scenario,
+                scenario: args.scenario.unwrap_or_default(),
                 scene_file: args.scene,
                 seconds: args.seconds,
                 dt: args.dt,
@@ -146,6 +160,10 @@ fn main() -> ExitCode {
                 gif: args.gif,
                 frames: args.frames,
                 plot: args.plot,
+                snapshot_at: args.snapshot_at,
+                snapshot: args.snapshot,
+                from: args.from,
+                stop_on_crossing: args.stop_on_crossing,
                 frame_settings: FrameSettings {
                     fps: args.fps,
                     width: args.size.0,

@@ -6,15 +6,15 @@ use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-
 use bevy_strands::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::Disc;
 
-/// A body moving on a circle, driving its hairs' roots.
-#[derive(Component, Reflect, Clone, Debug, PartialEq)]
-#[reflect(Component)]
-pub struct FurryCreature {
+/// What a furry creature is: the scenario file's `furry_creature` section.
+#[derive(Serialize, Deserialize, Reflect, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FurryCreatureSpec {
     /// Centre of the body's circular path.
     pub centre: DVec2,
     /// Radius of the path.
@@ -23,6 +23,34 @@ pub struct FurryCreature {
     pub period: f64,
     /// Radius of the body.
     pub body_radius: f64,
+    /// Hairs, evenly spaced around the rim.
+    pub hairs: usize,
+    /// Particles per hair.
+    pub particles_per_hair: usize,
+    /// Rest spacing of the hairs' particles.
+    pub spacing: f64,
+    /// Mass of each particle.
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl FurryCreatureSpec {
+    /// The body's centre at simulated time `t`.
+    pub fn body_centre(&self, t: f64) -> DVec2 {
+        self.centre + self.path_radius * DVec2::from_angle(TAU * t / self.period)
+    }
+}
+
+/// A body moving on a circle, driving its hairs' roots.
+#[derive(Component, Reflect, Clone, Debug, PartialEq)]
+#[reflect(Component)]
+pub struct FurryCreature {
+    /// The body, its path and its hairs.
+    pub spec: FurryCreatureSpec,
     /// Each driven particle and its offset from the body's centre.
     pub roots: Vec<(Entity, DVec2)>,
     /// Packed indices of `roots`, for the topology version in `cached_version`.
@@ -33,68 +61,60 @@ pub struct FurryCreature {
 }
 
 impl FurryCreature {
-    /// The body's centre at simulated time `t`.
-    pub fn body_centre(&self, t: f64) -> DVec2 {
-        self.centre + self.path_radius * DVec2::from_angle(TAU * t / self.period)
-    }
-}
-
-/// Spawn a creature with `hairs` hairs of `particles` particles, `spacing` apart,
-/// rooted evenly around the body's rim and pointing outwards.
-pub fn spawn_furry_creature(
-    world: &mut World,
-    creature: FurryCreature,
-    hairs: usize,
-    particles: usize,
-    spacing: f64,
-    mass: f64,
-) -> Entity {
-    let start = creature.body_centre(0.0);
-    let mut roots = Vec::with_capacity(2 * hairs);
-    for i in 0..hairs {
-        let outward = DVec2::from_angle(TAU * i as f64 / hairs as f64);
-        let strand = StrandBuilder::line(
-            start + creature.body_radius * outward,
-            outward,
-            particles,
-            spacing,
-        )
-        .pin(0)
-        .pin(1)
-        .mass(mass)
-        .kind(StrandKind::Hair)
-        .spawn_in(world)
-        .expect("a hair of at least two particles with positive spacing is valid");
-        let hair = &world.get::<Strand>(strand).expect("just spawned").particles;
-        for (k, &particle) in hair[..2].iter().enumerate() {
-            roots.push((
-                particle,
-                (creature.body_radius + k as f64 * spacing) * outward,
-            ));
-        }
-    }
-    let disc = Disc {
-        centre: start,
-        radius: creature.body_radius,
-    };
-    world
-        .spawn((FurryCreature { roots, ..creature }, disc))
-        .id()
-}
-
-impl FurryCreature {
-    /// A creature with no hairs yet (see [`spawn_furry_creature`]).
-    pub fn new(centre: DVec2, path_radius: f64, period: f64, body_radius: f64) -> Self {
+    /// A creature driving `roots` (particle, offset from the body's centre).
+    pub fn new(spec: FurryCreatureSpec, roots: Vec<(Entity, DVec2)>) -> Self {
         Self {
-            centre,
-            path_radius,
-            period,
-            body_radius,
-            roots: Vec::new(),
+            spec,
+            roots,
             cached: Vec::new(),
             cached_version: u64::MAX,
         }
     }
+
+    /// The creature's body as drawn at simulated time `t`.
+    pub fn disc(&self, t: f64) -> Disc {
+        Disc {
+            centre: self.spec.body_centre(t),
+            radius: self.spec.body_radius,
+        }
+    }
+}
+
+/// Spawn a creature: its hairs rooted evenly around the body's rim, pointing outwards.
+pub fn spawn_furry_creature(world: &mut World, spec: FurryCreatureSpec) -> Entity {
+    let start = spec.body_centre(0.0);
+    let mut roots = Vec::with_capacity(2 * spec.hairs);
+    for i in 0..spec.hairs {
+        let outward = DVec2::from_angle(TAU * i as f64 / spec.hairs as f64);
+        let spawned = StrandBuilder::line(
+            start + spec.body_radius * outward,
+            outward,
+            spec.particles_per_hair,
+            spec.spacing,
+        )
+        .pin(0)
+        .pin(1)
+        .mass(spec.mass)
+        .kind(StrandKind::Hair)
+        .spawn_in(world);
+        let strand = match spawned {
+            Ok(strand) => strand,
+            Err(e) => {
+                error!("furry creature: hair {i} was refused: {e}");
+                continue;
+            }
+        };
+        let hair = &world.get::<Strand>(strand).expect("just spawned").particles;
+        for (k, &particle) in hair[..2].iter().enumerate() {
+            roots.push((
+                particle,
+                (spec.body_radius + k as f64 * spec.spacing) * outward,
+            ));
+        }
+    }
+    let creature = FurryCreature::new(spec, roots);
+    let disc = creature.disc(0.0);
+    world.spawn((creature, disc)).id()
 }
 
 /// Give every root the velocity that lands it on the body's path at the end of the
@@ -117,11 +137,11 @@ pub fn drive_furry_creatures(
             creature.cached = cached;
             creature.cached_version = topology.version;
         }
-        let target = creature.body_centre(clock.time + dt);
+        let target = creature.spec.body_centre(clock.time + dt);
         for &(i, offset) in &creature.cached {
             let i = i as usize;
             state.velocity[i] = (target + offset - state.position[i]) / dt;
         }
-        disc.centre = creature.body_centre(clock.time);
+        *disc = creature.disc(clock.time);
     }
 }

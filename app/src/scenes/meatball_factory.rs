@@ -1,54 +1,56 @@
 //! The meatball factory: spinning triangles (3-particle loops) dropped into the box.
 //!
 //! Every `interval` seconds a triangle of side `side` appears at height `height`, at
-//! the next of a row of drop points (`drop_x`, `drop_x + step_x`, …, wrapping past
-//! `wrap_x` back to the lowest point above `low_x`), falling at `speed` and spinning at `spin` rad/s with alternating sign,
-//! until `max` have been dropped. A drop point with an edge nearby is skipped rather
-//! than spawning a triangle through it.
+//! the next of a row of drop points (`first_x`, `first_x + step_x`, …, wrapping past
+//! `wrap_x` back to the lowest point above `low_x`), falling at `speed` and spinning at
+//! `spin` rad/s with alternating sign, until `max` have been dropped. A drop point with
+//! an edge nearby is skipped rather than spawning a triangle through it.
 
 use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-
 use bevy_strands::model::geometry::closest_on_segment;
 use bevy_strands::prelude::*;
+use serde::{Deserialize, Serialize};
 
-/// A source of spinning triangles. Add it to an entity; the factory system does the rest.
-#[derive(Component, Reflect, Clone, Debug, PartialEq)]
-#[reflect(Component)]
-pub struct MeatballFactory {
+/// What a meatball factory drops: the scenario file's `meatball_factory` section.
+#[derive(Serialize, Deserialize, Reflect, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeatballFactorySpec {
     /// Seconds between drops.
     pub interval: f64,
+    /// Simulated time of the first drop.
+    #[serde(default)]
+    pub start: f64,
     /// Side of the triangles.
     pub side: f64,
-    /// Height of the triangles' centres when dropped.
+    /// Height the triangles' centres are dropped from.
     pub height: f64,
-    /// x of the next drop point.
-    pub drop_x: f64,
-    /// Step between drop points.
+    /// x of the first drop.
+    pub first_x: f64,
+    /// x step between drops.
     pub step_x: f64,
-    /// Drop points past this x wrap around by whole steps...
+    /// Drops past this x wrap around by whole steps...
     pub wrap_x: f64,
-    /// ...to the lowest point at or above this x.
+    /// ...to the lowest drop point at or above this x.
     pub low_x: f64,
     /// Initial falling speed.
     pub speed: f64,
-    /// Spin magnitude (rad/s); the sign alternates.
+    /// Spin magnitude (rad/s); the sign alternates from drop to drop.
     pub spin: f64,
     /// Triangles at most.
     pub max: usize,
     /// Mass of each particle.
+    #[serde(default = "one")]
     pub mass: f64,
-    /// Simulated time of the next drop.
-    pub next_drop: f64,
-    /// Triangles dropped so far.
-    pub dropped: usize,
-    /// Drops skipped because an edge was in the way.
-    pub skipped: usize,
 }
 
-impl MeatballFactory {
+fn one() -> f64 {
+    1.0
+}
+
+impl MeatballFactorySpec {
     /// The drop point after `x`: one step on, or, past `wrap_x`, back by whole steps to
     /// the lowest point at or above `low_x`.
     pub fn next_x(&self, x: f64) -> f64 {
@@ -57,6 +59,44 @@ impl MeatballFactory {
             next - self.step_x * ((next - self.low_x) / self.step_x).floor()
         } else {
             next
+        }
+    }
+}
+
+/// How far a meatball factory has got.
+#[derive(Serialize, Deserialize, Reflect, Clone, Copy, Debug, PartialEq)]
+pub struct MeatballProgress {
+    /// Simulated time of the next drop.
+    pub next_drop: f64,
+    /// x of the next drop point.
+    pub drop_x: f64,
+    /// Triangles dropped so far.
+    pub dropped: usize,
+    /// Drops skipped because an edge was in the way.
+    pub skipped: usize,
+}
+
+/// A source of spinning triangles. Add it to an entity; the factory system does the rest.
+#[derive(Component, Reflect, Clone, Debug, PartialEq)]
+#[reflect(Component)]
+pub struct MeatballFactory {
+    /// What it drops.
+    pub spec: MeatballFactorySpec,
+    /// How far it has got.
+    pub progress: MeatballProgress,
+}
+
+impl MeatballFactory {
+    /// A factory that has dropped nothing yet.
+    pub fn new(spec: MeatballFactorySpec) -> Self {
+        Self {
+            spec,
+            progress: MeatballProgress {
+                next_drop: spec.start,
+                drop_x: spec.first_x,
+                dropped: 0,
+                skipped: 0,
+            },
         }
     }
 }
@@ -72,39 +112,46 @@ pub fn run_meatball_factories(
 ) {
     let thickness = collisions.map_or(0.0, |c| c.thickness);
     for mut factory in &mut factories {
-        while factory.dropped < factory.max
-            && factory.next_drop <= clock.time + 1e-9 * factory.interval
+        let spec = factory.spec;
+        let progress = &mut factory.progress;
+        while progress.dropped < spec.max && progress.next_drop <= clock.time + 1e-9 * spec.interval
         {
-            let age = (clock.time - factory.next_drop).max(0.0);
-            factory.next_drop += factory.interval;
-            let x = factory.drop_x;
-            factory.drop_x = factory.next_x(x);
-            let centre = DVec2::new(x, factory.height - factory.speed * age);
-            let radius = factory.side / 3f64.sqrt();
+            let age = (clock.time - progress.next_drop).max(0.0);
+            progress.next_drop += spec.interval;
+            let x = progress.drop_x;
+            progress.drop_x = spec.next_x(x);
+            let centre = DVec2::new(x, spec.height - spec.speed * age);
+            let radius = spec.side / 3f64.sqrt();
             if edge_near(centre, radius + 2.0 * thickness, &state, &topology) {
-                factory.skipped += 1;
+                progress.skipped += 1;
                 continue;
             }
-            let spin = if factory.dropped % 2 == 0 {
-                factory.spin
+            let spin = if progress.dropped % 2 == 0 {
+                spec.spin
             } else {
-                -factory.spin
+                -spec.spin
             };
-            let turn = 0.37 * factory.dropped as f64; // vary the orientation a little
+            let turn = 0.37 * progress.dropped as f64; // vary the orientation a little
             let corners: Vec<DVec2> = (0..3)
                 .map(|i| centre + radius * DVec2::from_angle(turn + TAU * i as f64 / 3.0))
                 .collect();
             let velocities = corners
                 .iter()
-                .map(|&c| DVec2::new(0.0, -factory.speed) + spin * (c - centre).perp())
+                .map(|&c| DVec2::new(0.0, -spec.speed) + spin * (c - centre).perp())
                 .collect();
-            StrandBuilder::closed_loop(corners)
+            let spawned = StrandBuilder::closed_loop(corners)
                 .velocities(velocities)
-                .mass(factory.mass)
+                .mass(spec.mass)
                 .kind(StrandKind::Meatball)
-                .spawn(&mut commands)
-                .expect("a triangle of positive side is a valid loop");
-            factory.dropped += 1;
+                .spawn(&mut commands);
+            match spawned {
+                Ok(_) => progress.dropped += 1,
+                Err(e) => {
+                    // A validated spec makes valid triangles; say so if one is not.
+                    error!("meatball factory: a triangle was refused: {e}");
+                    progress.skipped += 1;
+                }
+            }
         }
     }
 }
@@ -126,11 +173,12 @@ mod tests {
 
     #[test]
     fn drop_points_follow_the_scenario() {
-        let factory = MeatballFactory {
+        let spec = MeatballFactorySpec {
             interval: 1.0,
+            start: 0.0,
             side: 0.08,
             height: 0.9,
-            drop_x: 0.5,
+            first_x: 0.5,
             step_x: 0.16,
             wrap_x: 0.9,
             low_x: 0.1,
@@ -138,14 +186,11 @@ mod tests {
             spin: 15.0,
             max: 16,
             mass: 1.0,
-            next_drop: 0.0,
-            dropped: 0,
-            skipped: 0,
         };
-        let mut x = factory.drop_x;
+        let mut x = spec.first_x;
         let mut seen = vec![x];
         for _ in 0..6 {
-            x = factory.next_x(x);
+            x = spec.next_x(x);
             seen.push(x);
         }
         let expected = [0.5, 0.66, 0.82, 0.18, 0.34, 0.5, 0.66];

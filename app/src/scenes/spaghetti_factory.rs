@@ -5,16 +5,22 @@
 //! rollers would; every `particles_per_strand` particles finish a strand and the next
 //! particle starts a new one. A strand is spawned — and constrained — as soon as it
 //! has two particles.
+//!
+//! A factory whose inlet is blocked — an edge of another strand within two thicknesses
+//! of where the held particles are about to move — stops its rollers (the held particles
+//! stand still) and postpones its emissions by the time it stands, rather than pushing
+//! pinned particles, which nothing can stop, through the pile.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-
+use bevy_strands::model::geometry::segment_distance;
 use bevy_strands::prelude::*;
+use serde::{Deserialize, Serialize};
 
-/// An inlet emitting strands. Add it to an entity; the factory system does the rest.
-#[derive(Component, Reflect, Clone, Debug, PartialEq)]
-#[reflect(Component)]
-pub struct SpaghettiFactory {
+/// What a spaghetti factory makes: the scenario file's `spaghetti_factory` section.
+#[derive(Serialize, Deserialize, Reflect, Clone, Copy, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpaghettiFactorySpec {
     /// Where particles appear.
     pub inlet: DVec2,
     /// Their velocity at the inlet.
@@ -24,75 +30,181 @@ pub struct SpaghettiFactory {
     /// Particles per strand.
     pub particles_per_strand: usize,
     /// Newest particles held at the inlet velocity.
+    #[serde(default = "two")]
     pub held: usize,
     /// Mass of each particle.
+    #[serde(default = "one")]
     pub mass: f64,
-    /// Material of the strands (the global default if `None`).
-    pub material: Option<StrandMaterial>,
     /// Stop after this many strands (`None`: never).
+    #[serde(default)]
     pub max_strands: Option<usize>,
+}
+
+fn two() -> usize {
+    2
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl SpaghettiFactorySpec {
+    /// Rest spacing of the strands.
+    pub fn spacing(&self) -> f64 {
+        self.velocity.length() * self.interval
+    }
+}
+
+/// How far a factory has got.
+#[derive(Reflect, Clone, Debug, Default, PartialEq)]
+pub struct SpaghettiProgress {
     /// Simulated time of the next emission.
     pub next_emission: f64,
     /// Strands finished or in progress.
     pub strands_started: usize,
     /// Particles of the strand being extruded, oldest first.
-    current: Vec<Entity>,
+    pub current: Vec<Entity>,
     /// Its strand entity, once it has two particles.
-    current_strand: Option<Entity>,
+    pub current_strand: Option<Entity>,
+    /// Whether the inlet is blocked (the rollers stand still).
+    pub blocked: bool,
+    /// Ticks the inlet has been blocked, in all.
+    pub blocked_ticks: u64,
+}
+
+/// An inlet emitting strands. Add it to an entity; the factory system does the rest.
+#[derive(Component, Reflect, Clone, Debug, PartialEq)]
+#[reflect(Component)]
+pub struct SpaghettiFactory {
+    /// What it makes.
+    pub spec: SpaghettiFactorySpec,
+    /// Material of the strands (the global default if `None`).
+    pub material: Option<StrandMaterial>,
+    /// How far it has got.
+    pub progress: SpaghettiProgress,
 }
 
 impl SpaghettiFactory {
-    /// A factory emitting from `inlet` at `velocity`, a particle every `interval`.
-    pub fn new(inlet: DVec2, velocity: DVec2, interval: f64, particles_per_strand: usize) -> Self {
+    /// A factory that has emitted nothing yet.
+    pub fn new(spec: SpaghettiFactorySpec) -> Self {
         Self {
-            inlet,
-            velocity,
-            interval,
-            particles_per_strand,
-            held: 2,
-            mass: 1.0,
+            spec,
             material: None,
-            max_strands: None,
-            next_emission: 0.0,
-            strands_started: 0,
-            current: Vec::new(),
-            current_strand: None,
+            progress: SpaghettiProgress::default(),
         }
     }
 
-    /// Rest spacing of the strands.
-    pub fn spacing(&self) -> f64 {
-        self.velocity.length() * self.interval
+    /// The particles the rollers hold: the newest ones of the strand being extruded.
+    pub fn held_particles(&self) -> &[Entity] {
+        let current = &self.progress.current;
+        &current[current.len().saturating_sub(self.spec.held)..]
     }
 
     fn finished(&self) -> bool {
-        self.max_strands
-            .is_some_and(|max| self.strands_started >= max)
-            && self.current.is_empty()
+        self.spec
+            .max_strands
+            .is_some_and(|max| self.progress.strands_started >= max)
+            && self.progress.current.is_empty()
     }
 }
 
-/// Emit the particles due by the current simulated time.
+/// Emit the particles due by the current simulated time; hold the rollers while the
+/// inlet is blocked.
+#[allow(clippy::too_many_arguments)]
 pub fn run_spaghetti_factories(
     mut commands: Commands,
     clock: Res<SimulationClock>,
+    config: Res<StrandsConfig>,
+    collisions: Option<Res<CollisionConfig>>,
+    state: Res<ParticleState>,
+    topology: Res<Topology>,
     mut factories: Query<&mut SpaghettiFactory>,
     mut strands: Query<&mut Strand>,
+    mut velocities: Query<&mut Velocity>,
 ) {
+    let reach = 2.0 * collisions.map_or(0.0, |c| c.thickness);
+    let tick = config.tick_seconds();
     for mut factory in &mut factories {
+        let blocked = inlet_blocked(&factory, tick, reach, &state, &topology);
+        if blocked != factory.progress.blocked {
+            let velocity = if blocked {
+                DVec2::ZERO
+            } else {
+                factory.spec.velocity
+            };
+            for &p in factory.held_particles() {
+                if let Ok(mut v) = velocities.get_mut(p) {
+                    v.0 = velocity;
+                }
+            }
+            factory.progress.blocked = blocked;
+        }
+        if blocked {
+            // The extrusion stands still: so does its schedule.
+            factory.progress.next_emission += tick;
+            factory.progress.blocked_ticks += 1;
+            continue;
+        }
+        let interval = factory.spec.interval;
         // A little slack so that emission times on tick boundaries are not missed by
         // rounding of the clock.
-        while !factory.finished() && factory.next_emission <= clock.time + 1e-9 * factory.interval {
-            let emitted_at = factory.next_emission;
+        while !factory.finished() && factory.progress.next_emission <= clock.time + 1e-9 * interval
+        {
+            let emitted_at = factory.progress.next_emission;
             emit(
                 &mut commands,
                 &mut factory,
                 &mut strands,
                 clock.time - emitted_at,
             );
-            factory.next_emission += factory.interval;
+            factory.progress.next_emission += interval;
         }
     }
+}
+
+/// Whether an edge of another strand lies within `reach` of the stretch the held
+/// particles sweep in the coming tick (from the inlet to a tick past the oldest held
+/// particle) and is not moving on ahead of them: the tail of the strand just finished,
+/// leaving at the inlet's speed, is no obstacle; a pile grown up to the inlet is.
+fn inlet_blocked(
+    factory: &SpaghettiFactory,
+    tick: f64,
+    reach: f64,
+    state: &ParticleState,
+    topology: &Topology,
+) -> bool {
+    if reach <= 0.0 || factory.finished() {
+        return false;
+    }
+    let spec = &factory.spec;
+    let index = |p: &Entity| topology.index.get(p).copied();
+    let held = factory.held_particles();
+    let is_held = |i: u32| held.iter().any(|p| index(p) == Some(i));
+    // The held particles lie on the line from the inlet; the oldest leads.
+    let lead = held
+        .first()
+        .and_then(index)
+        .map_or(spec.inlet, |i| state.position[i as usize]);
+    let (from, to) = (spec.inlet, lead + spec.velocity * tick);
+    let own = factory
+        .progress
+        .current_strand
+        .and_then(|s| topology.strands.iter().position(|r| r.entity == s));
+    let speed = spec.velocity.length();
+    let ahead = spec.velocity / speed;
+    let keeps_ahead = |i: usize| state.velocity[i].dot(ahead) >= 0.5 * speed;
+    // Walls cannot move into the inlet; only what the pile brings up can block it.
+    topology.edges.iter().any(|e| {
+        let (a, b) = (e.a as usize, e.b as usize);
+        !e.is_static
+            && Some(e.strand as usize) != own
+            && a < state.position.len()
+            && b < state.position.len()
+            && !is_held(e.a)
+            && !is_held(e.b)
+            && !(keeps_ahead(a) && keeps_ahead(b))
+            && segment_distance(from, to, state.position[a], state.position[b]) < reach
+    })
 }
 
 fn emit(
@@ -101,44 +213,47 @@ fn emit(
     strands: &mut Query<&mut Strand>,
     age: f64,
 ) {
-    if factory.current.is_empty() {
-        factory.strands_started += 1;
+    let spec = factory.spec;
+    let material = factory.material;
+    let progress = &mut factory.progress;
+    if progress.current.is_empty() {
+        progress.strands_started += 1;
     }
     // Where the particle would be had it appeared exactly on time.
-    let position = factory.inlet + factory.velocity * age.max(0.0);
+    let position = spec.inlet + spec.velocity * age.max(0.0);
     let mut particle = commands.spawn((
         Particle,
         Position(position),
-        Velocity(factory.velocity),
-        Mass(factory.mass),
+        Velocity(spec.velocity),
+        Mass(spec.mass),
         Pinned,
     ));
-    if let Some(strand) = factory.current_strand {
+    if let Some(strand) = progress.current_strand {
         particle.insert(StrandOf(strand));
     }
     let particle = particle.id();
-    factory.current.push(particle);
-    let spacing = factory.spacing();
+    progress.current.push(particle);
+    let spacing = spec.spacing();
 
-    match factory.current_strand {
-        None if factory.current.len() == 2 => {
+    match progress.current_strand {
+        None if progress.current.len() == 2 => {
             let mut strand = commands.spawn((
                 Strand {
-                    particles: factory.current.clone(),
+                    particles: progress.current.clone(),
                     rest_lengths: vec![spacing],
                     rest_angles: Vec::new(),
                     closed: false,
                 },
                 StrandKind::Spaghetti,
             ));
-            if let Some(material) = factory.material {
+            if let Some(material) = material {
                 strand.insert(material);
             }
             let strand = strand.id();
-            for &p in &factory.current {
+            for &p in &progress.current {
                 commands.entity(p).insert(StrandOf(strand));
             }
-            factory.current_strand = Some(strand);
+            progress.current_strand = Some(strand);
         }
         Some(entity) => {
             if let Ok(mut strand) = strands.get_mut(entity) {
@@ -150,14 +265,14 @@ fn emit(
     }
 
     // Release what the rollers no longer hold; a finished strand is let go entirely.
-    let done = factory.current.len() >= factory.particles_per_strand;
-    let keep = if done { 0 } else { factory.held };
-    let release = factory.current.len().saturating_sub(keep);
-    for &p in &factory.current[..release] {
+    let done = progress.current.len() >= spec.particles_per_strand;
+    let keep = if done { 0 } else { spec.held };
+    let release = progress.current.len().saturating_sub(keep);
+    for &p in &progress.current[..release] {
         commands.entity(p).remove::<Pinned>();
     }
     if done {
-        factory.current.clear();
-        factory.current_strand = None;
+        progress.current.clear();
+        progress.current_strand = None;
     }
 }

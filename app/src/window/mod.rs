@@ -26,8 +26,9 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use bevy_strands::render::StrandsDebugDrawPlugin;
 
+use crate::builtin::{builtin, builtin_names};
 use crate::scenario::{Scenario, ScenarioError};
-use crate::scenes::{ScenesPlugin, builtin, builtin_names};
+use crate::scenes::ScenesPlugin;
 use crate::spawn::spawn_scenario;
 
 pub use layout::UiLayout;

@@ -1,0 +1,152 @@
+//! Snapshots: a run continued from a snapshot ends exactly as the run it was taken from,
+//! and broken snapshot files are refused with a message naming the file and the problem.
+
+use std::path::PathBuf;
+
+use bevy_strands_app::report::Report;
+use bevy_strands_app::runner::{RunOptions, run};
+use bevy_strands_app::snapshot::RunSnapshot;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bevy_strands_snapshots_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn options(scenario: &str, seconds: f64) -> RunOptions {
+    RunOptions {
+        scenario: scenario.into(),
+        seconds: Some(seconds),
+        check_crossings: true,
+        ..Default::default()
+    }
+}
+
+fn run_ok(options: &RunOptions) -> Report {
+    run(options, |_| {}).unwrap_or_else(|e| panic!("{}: {e}", options.scenario))
+}
+
+/// Every figure of the report but the cost and the notes.
+fn figures(report: &Report) -> serde_json::Value {
+    let mut value = serde_json::to_value(report).unwrap();
+    let object = value.as_object_mut().unwrap();
+    for key in [
+        "wall_seconds",
+        "particle_steps_per_second",
+        "notes",
+        "config",
+    ] {
+        object.remove(key);
+    }
+    value
+}
+
+#[test]
+fn a_run_continued_from_a_snapshot_ends_as_the_uninterrupted_run() {
+    // The factories' progress (a strand half extruded at 0.8 s, a meatball dropped at
+    // 0.5 s and the next due at 2.0 s) and the creature's roots go through the file.
+    for (scenario, at, end) in [
+        ("spaghetti_factory", 0.8, 1.5),
+        ("meatball_factory", 1.0, 2.2),
+        ("furry_creature", 0.02, 0.05),
+    ] {
+        let whole = run_ok(&options(scenario, end));
+        let file = scratch(&format!("{scenario}.ron"));
+        let first = run_ok(&RunOptions {
+            snapshot_at: Some(at),
+            snapshot: Some(file.clone()),
+            ..options(scenario, at)
+        });
+        assert!(
+            first.notes.iter().any(|n| n.contains("snapshot written")),
+            "{:?}",
+            first.notes
+        );
+        let rest = run_ok(&RunOptions {
+            from: Some(file.clone()),
+            ..options("", end)
+        });
+        assert_eq!(figures(&rest), figures(&whole), "{scenario}");
+        assert!(
+            rest.notes[0].starts_with("continued from"),
+            "{:?}",
+            rest.notes
+        );
+        // The file reads back as what was written.
+        let snapshot = RunSnapshot::load(&file).unwrap();
+        let again = scratch(&format!("{scenario}_again.ron"));
+        snapshot.save(&again).unwrap();
+        assert_eq!(RunSnapshot::load(&again).unwrap(), snapshot);
+    }
+}
+
+#[test]
+fn broken_snapshots_are_refused_with_the_file_and_the_problem() {
+    let missing = run(
+        &RunOptions {
+            from: Some("no/such/snapshot.ron".into()),
+            ..options("", 1.0)
+        },
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(missing.starts_with("no/such/snapshot.ron: "), "{missing}");
+
+    let file = scratch("good.ron");
+    run_ok(&RunOptions {
+        snapshot_at: Some(0.2),
+        snapshot: Some(file.clone()),
+        ..options("spaghetti_factory", 0.2)
+    });
+    let text = std::fs::read_to_string(&file).unwrap();
+    let broken = scratch("broken.ron");
+    std::fs::write(&broken, &text[..text.len() / 2]).unwrap();
+    let message = run(
+        &RunOptions {
+            from: Some(broken.clone()),
+            ..options("", 1.0)
+        },
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        message.contains("broken.ron: line") && message.contains("column"),
+        "{message}"
+    );
+
+    // A strand naming a particle the snapshot does not hold.
+    let mut snapshot = RunSnapshot::load(&file).unwrap();
+    let count = snapshot.state.particles.len() as u32;
+    snapshot.state.strands[0].particles[0] = count + 5;
+    let inconsistent = scratch("inconsistent.ron");
+    snapshot.save(&inconsistent).unwrap();
+    let message = run(
+        &RunOptions {
+            from: Some(inconsistent),
+            ..options("", 1.0)
+        },
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        message.contains(&format!("names particle {}", count + 5)),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_snapshot_needs_both_its_time_and_its_file() {
+    let message = run(
+        &RunOptions {
+            snapshot_at: Some(0.1),
+            ..options("long_strand", 0.2)
+        },
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(message.contains("give both"), "{message}");
+}

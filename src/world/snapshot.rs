@@ -1,0 +1,284 @@
+//! Snapshots: the simulated state of a world — every particle and strand and the clock —
+//! captured as plain data, and restored into another world so that the simulation
+//! continues exactly as it would have (save games, reproductions of a rare event, tests).
+//!
+//! Particles are numbered by their position in [`StrandsSnapshot::particles`]; strands
+//! refer to them by that number. Both lists are kept in the order the topology rebuild
+//! sorts entities in, and [`StrandsSnapshot::restore`] spawns them so that the new
+//! entities sort the same way: the packed order, and with it every sum of a step, is
+//! then the same as in the world captured, and a restored run continues bit for bit.
+
+use bevy::ecs::entity::EntityHashMap;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::world::clock::SimulationClock;
+use crate::world::particle::{ExternalForce, Mass, Particle, Pinned, Position, Velocity};
+use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
+
+/// A particle as captured.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ParticleRecord {
+    /// Position.
+    pub position: DVec2,
+    /// Velocity.
+    pub velocity: DVec2,
+    /// Mass.
+    pub mass: f64,
+    /// Whether it is pinned.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub pinned: bool,
+    /// Its constant external force, if it has one.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub external_force: Option<DVec2>,
+    /// The strand that owns it (index into [`StrandsSnapshot::strands`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub owner: Option<u32>,
+}
+
+/// A strand as captured: its particles by their number in the snapshot.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct StrandRecord {
+    /// Particles in order along the strand.
+    pub particles: Vec<u32>,
+    /// Rest length of each edge.
+    pub rest_lengths: Vec<f64>,
+    /// Rest turning angle at each bending vertex (empty: straight).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub rest_angles: Vec<f64>,
+    /// Whether the strand is a loop.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub closed: bool,
+    /// What it represents.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub kind: StrandKind,
+    /// Its own material, if it has one.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub material: Option<StrandMaterial>,
+}
+
+/// The simulated state of a world.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct StrandsSnapshot {
+    /// Simulated time and steps.
+    pub clock: SimulationClock,
+    /// Every particle, in entity order.
+    pub particles: Vec<ParticleRecord>,
+    /// Every strand, in entity order.
+    pub strands: Vec<StrandRecord>,
+}
+
+/// Which entity each number of a snapshot stands for.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SnapshotEntities {
+    /// The entity of each particle, by its number in the snapshot.
+    pub particles: Vec<Entity>,
+    /// The entity of each strand, by its number in the snapshot.
+    pub strands: Vec<Entity>,
+}
+
+impl SnapshotEntities {
+    /// The number of `particle` in the snapshot, if it is one of its particles.
+    pub fn particle_number(&self, particle: Entity) -> Option<u32> {
+        // Particles are kept in entity order, so the list is sorted.
+        self.particles
+            .binary_search(&particle)
+            .ok()
+            .map(|i| i as u32)
+    }
+
+    /// The number of `strand` in the snapshot, if it is one of its strands.
+    pub fn strand_number(&self, strand: Entity) -> Option<u32> {
+        self.strands.binary_search(&strand).ok().map(|i| i as u32)
+    }
+}
+
+/// Why a snapshot cannot be restored.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum SnapshotError {
+    /// A strand names a particle the snapshot does not have.
+    #[error("strand {strand} names particle {particle}, but the snapshot has {count} particles")]
+    MissingParticle {
+        /// The strand.
+        strand: usize,
+        /// The particle it names.
+        particle: u32,
+        /// How many particles there are.
+        count: usize,
+    },
+    /// A particle names an owner strand the snapshot does not have.
+    #[error(
+        "particle {particle} is owned by strand {strand}, but the snapshot has {count} strands"
+    )]
+    MissingOwner {
+        /// The particle.
+        particle: usize,
+        /// The owner it names.
+        strand: u32,
+        /// How many strands there are.
+        count: usize,
+    },
+    /// Something outside the particle and strand lists names a particle the snapshot
+    /// does not hold.
+    #[error("the snapshot names particle {0}, but does not hold it")]
+    UnknownParticle(u32),
+    /// The world already holds particles or strands, so the restored entities could
+    /// not keep the captured order.
+    #[error("the world already holds {0} particles or strands; restore into an empty one")]
+    NotEmpty(usize),
+}
+
+impl StrandsSnapshot {
+    /// Capture every particle and strand of `world`, and the clock.
+    pub fn capture(world: &mut World) -> (StrandsSnapshot, SnapshotEntities) {
+        let mut strand_query = world.query_filtered::<Entity, With<Strand>>();
+        let mut strands: Vec<Entity> = strand_query.iter(world).collect();
+        strands.sort();
+        let mut particle_query = world.query_filtered::<Entity, With<Particle>>();
+        let mut particles: Vec<Entity> = particle_query.iter(world).collect();
+        particles.sort();
+        let entities = SnapshotEntities { particles, strands };
+        let number: EntityHashMap<u32> = entities
+            .particles
+            .iter()
+            .enumerate()
+            .map(|(i, &e)| (e, i as u32))
+            .collect();
+        let particles = entities
+            .particles
+            .iter()
+            .map(|&e| {
+                let entity = world.entity(e);
+                ParticleRecord {
+                    position: entity.get::<Position>().map_or(DVec2::ZERO, |p| p.0),
+                    velocity: entity.get::<Velocity>().map_or(DVec2::ZERO, |v| v.0),
+                    mass: entity.get::<Mass>().map_or(1.0, |m| m.0),
+                    pinned: entity.contains::<Pinned>(),
+                    external_force: entity.get::<ExternalForce>().map(|f| f.0),
+                    owner: entity
+                        .get::<StrandOf>()
+                        .and_then(|owner| entities.strand_number(owner.0)),
+                }
+            })
+            .collect();
+        let strands = entities
+            .strands
+            .iter()
+            .map(|&e| {
+                let entity = world.entity(e);
+                let strand = entity.get::<Strand>().expect("queried with Strand");
+                StrandRecord {
+                    // A strand naming a despawned particle is split at the next rebuild;
+                    // capture what is there now and leave the gap to that rebuild.
+                    particles: strand
+                        .particles
+                        .iter()
+                        .map(|p| number.get(p).copied().unwrap_or(u32::MAX))
+                        .collect(),
+                    rest_lengths: strand.rest_lengths.clone(),
+                    rest_angles: strand.rest_angles.clone(),
+                    closed: strand.closed,
+                    kind: entity.get::<StrandKind>().copied().unwrap_or_default(),
+                    material: entity.get::<StrandMaterial>().copied(),
+                }
+            })
+            .collect();
+        let snapshot = StrandsSnapshot {
+            clock: *world.resource::<SimulationClock>(),
+            particles,
+            strands,
+        };
+        (snapshot, entities)
+    }
+
+    /// Check that every number the snapshot uses refers to something it holds.
+    pub fn check(&self) -> Result<(), SnapshotError> {
+        for (strand, record) in self.strands.iter().enumerate() {
+            if let Some(&particle) = record
+                .particles
+                .iter()
+                .find(|&&p| p as usize >= self.particles.len())
+            {
+                return Err(SnapshotError::MissingParticle {
+                    strand,
+                    particle,
+                    count: self.particles.len(),
+                });
+            }
+        }
+        for (particle, record) in self.particles.iter().enumerate() {
+            if let Some(strand) = record.owner.filter(|&s| s as usize >= self.strands.len()) {
+                return Err(SnapshotError::MissingOwner {
+                    particle,
+                    strand,
+                    count: self.strands.len(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Spawn the snapshot's particles and strands into `world`, which must hold none
+    /// yet, and set its clock. Nothing is spawned if the snapshot is inconsistent.
+    pub fn restore(&self, world: &mut World) -> Result<SnapshotEntities, SnapshotError> {
+        self.check()?;
+        let mut existing = world.query_filtered::<(), Or<(With<Particle>, With<Strand>)>>();
+        let count = existing.iter(world).count();
+        if count > 0 {
+            return Err(SnapshotError::NotEmpty(count));
+        }
+        // A fresh world hands out entity indices in increasing order, and entities sort
+        // with later indices first: spawn in reverse to keep the captured order.
+        let mut strands = vec![Entity::PLACEHOLDER; self.strands.len()];
+        for (slot, record) in strands.iter_mut().zip(&self.strands).rev() {
+            let mut entity = world.spawn(record.kind);
+            if let Some(material) = record.material {
+                entity.insert(material);
+            }
+            *slot = entity.id();
+        }
+        let mut particles = vec![Entity::PLACEHOLDER; self.particles.len()];
+        for (slot, record) in particles.iter_mut().zip(&self.particles).rev() {
+            let mut entity = world.spawn((
+                Particle,
+                Position(record.position),
+                Velocity(record.velocity),
+                Mass(record.mass),
+            ));
+            if record.pinned {
+                entity.insert(Pinned);
+            }
+            if let Some(force) = record.external_force {
+                entity.insert(ExternalForce(force));
+            }
+            if let Some(owner) = record.owner {
+                entity.insert(StrandOf(strands[owner as usize]));
+            }
+            *slot = entity.id();
+        }
+        for (&entity, record) in strands.iter().zip(&self.strands) {
+            world.entity_mut(entity).insert(Strand {
+                particles: record
+                    .particles
+                    .iter()
+                    .map(|&p| particles[p as usize])
+                    .collect(),
+                rest_lengths: record.rest_lengths.clone(),
+                rest_angles: record.rest_angles.clone(),
+                closed: record.closed,
+            });
+        }
+        *world.resource_mut::<SimulationClock>() = self.clock;
+        let restored = SnapshotEntities { particles, strands };
+        if !(restored.particles.is_sorted() && restored.strands.is_sorted()) {
+            warn!(
+                "bevy_strands: the restored entities do not sort as the captured ones did; \
+                 the run continues, but not bit for bit"
+            );
+        }
+        Ok(restored)
+    }
+}
