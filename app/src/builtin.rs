@@ -55,6 +55,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/scale.ron"),
     },
     BuiltinScene {
+        name: "pile",
+        file: "assets/scenes/pile.ron",
+        text: include_str!("../../assets/scenes/pile.ron"),
+    },
+    BuiltinScene {
         name: "sandbox",
         file: "assets/scenes/sandbox.ron",
         text: include_str!("../../assets/scenes/sandbox.ron"),

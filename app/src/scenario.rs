@@ -104,7 +104,8 @@ pub struct Scenario {
     pub scale: Option<ScaleSpec>,
 }
 
-/// The scale scenario's strands.
+/// Many straight strands in rows, dropped into a box sized to hold them (the scale and
+/// pile scenarios).
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ScaleSpec {
@@ -114,6 +115,13 @@ pub struct ScaleSpec {
     pub particles: usize,
     /// Rest spacing.
     pub spacing: f64,
+    /// Strands per row (default: about √(strands / 8)).
+    #[serde(default)]
+    pub columns: Option<usize>,
+    /// Horizontal and vertical distance between the rows' strands (default: the
+    /// strand's length plus five spacings, and four spacings).
+    #[serde(default)]
+    pub pitch: Option<(f64, f64)>,
 }
 
 fn one() -> f64 {
@@ -427,6 +435,19 @@ impl Scenario {
         if let Some(scale) = &self.scale {
             let at = number("scale");
             positive("spacing", scale.spacing).map_err(at)?;
+            if let Some((x, y)) = scale.pitch {
+                positive("pitch.0", x).map_err(at)?;
+                positive("pitch.1", y).map_err(at)?;
+                if x <= scale.strand_length() {
+                    return Err(fail(
+                        "scale.pitch",
+                        format!(
+                            "{x} must exceed the strands' length {}: they would overlap",
+                            scale.strand_length()
+                        ),
+                    ));
+                }
+            }
             at_least("strands", scale.strands, 1, "a scale run").map_err(at)?;
             at_least("particles", scale.particles, 2, "a strand").map_err(at)?;
         }
@@ -504,7 +525,9 @@ impl Scenario {
 impl ScaleSpec {
     /// Strands per row of the initial arrangement.
     pub fn columns(&self) -> usize {
-        ((self.strands as f64 / 8.0).sqrt().ceil() as usize).max(1)
+        self.columns
+            .unwrap_or_else(|| (self.strands as f64 / 8.0).sqrt().ceil() as usize)
+            .max(1)
     }
 
     /// Length of one strand.
@@ -514,10 +537,20 @@ impl ScaleSpec {
 
     /// Horizontal and vertical pitch of the arrangement.
     pub fn pitch(&self) -> DVec2 {
-        DVec2::new(
-            self.strand_length() + 5.0 * self.spacing,
-            4.0 * self.spacing,
+        self.pitch.map_or(
+            DVec2::new(
+                self.strand_length() + 5.0 * self.spacing,
+                4.0 * self.spacing,
+            ),
+            |(x, y)| DVec2::new(x, y),
         )
+    }
+
+    /// Height of the gentle wave along each strand, so that strands do not land
+    /// perfectly flat on each other: half a spacing, or a quarter of the rows' pitch
+    /// when they are packed closer.
+    pub fn wave(&self) -> f64 {
+        (0.5 * self.spacing).min(0.25 * self.pitch().y)
     }
 
     /// The box the strands start in and fall into.

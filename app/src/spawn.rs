@@ -34,7 +34,7 @@ pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), Scenari
             let start = scale.start(s);
             // A gentle wave so that strands do not land perfectly flat on each other.
             let points = (0..scale.particles).map(|i| {
-                let wave = 0.5 * scale.spacing * ((i + 3 * s) as f64 * 0.4).sin();
+                let wave = scale.wave() * ((i + 3 * s) as f64 * 0.4).sin();
                 start + step * i as f64 + DVec2::new(0.0, wave)
             });
             StrandBuilder::polyline(points)
