@@ -43,6 +43,8 @@ impl Plugin for ContactLoopPlugin {
 pub struct ContactRows {
     /// The rows.
     pub rows: Vec<ContactRow>,
+    /// A particle of each island whose re-projection failed this step.
+    failed: Vec<u32>,
 }
 
 /// The ContactLoop sub-stage: alternate re-projection with contact rows and collision
@@ -70,6 +72,7 @@ pub fn contact_loop(
     };
     let impulse_settings = collisions.impulse_settings();
     let scratch = &mut *scratch;
+    islands.begin_contact_step();
     let mut changed = scratch.outcome.impulses > 0;
     let mut collider = collider(
         &mut state,
@@ -94,7 +97,15 @@ pub fn contact_loop(
         changed = round.impulses > 0;
         scratch.outcome.add(round);
     }
-    metrics.contact_unsettled_steps += u64::from(changed);
+    islands.failed_particles(&mut rows.failed);
+    let unsettled = changed || !rows.failed.is_empty();
+    if unsettled {
+        // Impulses after the last projection, or a projection that failed: rather than
+        // leave the edges next to those contacts stretched, end the step with their
+        // islands rigid.
+        scratch.outcome.add(collider.finish_rigidly(&rows.failed));
+    }
+    metrics.contact_unsettled_steps += u64::from(unsettled);
 }
 
 /// Project the islands the contacts touched onto their constraints again, with the
@@ -151,6 +162,7 @@ fn reproject(
         ..Bodies::new(collider.position, collider.velocity, collider.inverse_mass)
     };
     islands.project_with_contacts(
+        collider.groups,
         &mut bodies,
         rows,
         dt,

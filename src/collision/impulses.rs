@@ -61,14 +61,17 @@ pub struct ImpulseScratch {
     /// The fail-safe's rigid impact zones of this step.
     pub zones: ImpactZones,
     hits: Vec<(u32, u32, u32)>,
+    /// The pairs that took impulses in the latest round of passes.
+    round: Vec<(u32, u32, u32)>,
 }
 
 impl ImpulseScratch {
-    /// Forget the previous step's contacts and zones.
-    pub fn begin_step(&mut self, particles: usize) {
+    /// Forget the previous step's contacts and zones; `groups` gives each particle's
+    /// rigid group (constraint island).
+    pub fn begin_step(&mut self, groups: &[u32]) {
         self.contacts.clear();
         self.contact_index.clear();
-        self.zones.reset(particles);
+        self.zones.reset(groups);
     }
 
     /// Whether point `p` met edge `edge` this step.
@@ -125,6 +128,9 @@ pub struct Collider<'a> {
     pub mass: &'a [f64],
     /// Inverse masses (0: pinned).
     pub inverse_mass: &'a [f64],
+    /// The rigid group (constraint island) of each particle: a fail-safe zone takes in
+    /// whole groups.
+    pub groups: &'a [u32],
     /// Set for every free particle that takes part in a contact.
     pub in_contact: &'a mut [bool],
     /// The settings.
@@ -189,6 +195,9 @@ impl Collider<'_> {
         };
         // One record per point and edge: the latest contact between them.
         let scratch = &mut *self.scratch;
+        scratch
+            .round
+            .push((pair.p as u32, pair.q as u32, pair.r as u32));
         let next = scratch.contacts.len() as u32;
         let slot = *scratch
             .contact_index
@@ -312,6 +321,7 @@ impl Collider<'_> {
     /// pairs predate a velocity change.
     pub fn resolve_crossings(&mut self, mut stale: bool) -> CollisionOutcome {
         let mut outcome = CollisionOutcome::default();
+        self.scratch.round.clear();
         for _ in 0..self.settings.max_iterations {
             if stale {
                 self.find_pairs();
@@ -323,19 +333,54 @@ impl Collider<'_> {
             }
             stale = true;
         }
-        outcome.failsafe = true;
-        outcome.unresolved = self.fail_safe();
-        outcome.first_unresolved = (outcome.unresolved > 0)
-            .then(|| self.scratch.hits.first().map(|&(p, q, r)| [p, q, r]))
-            .flatten();
-        outcome
+        let mut failsafe = self.fail_safe(false);
+        failsafe.impulses = outcome.impulses;
+        failsafe
     }
 
-    /// Rigid impact zones until no approaching contact is left; returns the number
-    /// left unresolved.
-    fn fail_safe(&mut self) -> usize {
+    /// End the step rigidly: the islands that took impulses in the latest round of
+    /// passes, and those of the particles in `also`, move as exact rigid zones, merged
+    /// with whatever they still meet, so that no impulse is left stretching an edge. For
+    /// a step whose contacts did not settle.
+    pub fn finish_rigidly(&mut self, also: &[u32]) -> CollisionOutcome {
+        let scratch = &mut *self.scratch;
+        scratch.round.extend(also.iter().map(|&p| (p, p, p)));
+        self.fail_safe(true)
+    }
+
+    /// Rigid impact zones until no collision is left, seeded with the latest round's
+    /// pairs when `seeded`.
+    fn fail_safe(&mut self, seeded: bool) -> CollisionOutcome {
+        let unresolved = self.zones_until_clean(seeded);
+        CollisionOutcome {
+            failsafe: true,
+            unresolved,
+            first_unresolved: (unresolved > 0)
+                .then(|| self.scratch.hits.first().map(|&(p, q, r)| [p, q, r]))
+                .flatten(),
+            ..CollisionOutcome::default()
+        }
+    }
+
+    /// Rigid impact zones until no collision is left; returns the number left
+    /// unresolved.
+    fn zones_until_clean(&mut self, seeded: bool) -> usize {
         let n = self.position.len();
-        self.scratch.zones.reset(n);
+        self.scratch.zones.reset(self.groups);
+        if seeded {
+            let zones = &mut self.scratch.zones;
+            for &(p, q, r) in &self.scratch.round {
+                zones.join(p as usize, q as usize, self.groups);
+                zones.join(p as usize, r as usize, self.groups);
+            }
+            zones.rigidify(
+                self.position,
+                self.velocity,
+                self.mass,
+                self.inverse_mass,
+                self.dt,
+            );
+        }
         for _round in 0..(4 * n + 16) {
             self.find_pairs();
             self.scratch.hits.clear();
@@ -353,8 +398,8 @@ impl Collider<'_> {
             let zones = &mut self.scratch.zones;
             let mut merged = false;
             for &(p, q, r) in &self.scratch.hits {
-                merged |= zones.join(p as usize, q as usize);
-                merged |= zones.join(p as usize, r as usize);
+                merged |= zones.join(p as usize, q as usize, self.groups);
+                merged |= zones.join(p as usize, r as usize, self.groups);
             }
             if !merged {
                 // Collisions inside zones: their rotation is the culprit.
@@ -366,7 +411,13 @@ impl Collider<'_> {
                     return self.scratch.hits.len();
                 }
             }
-            zones.rigidify(self.position, self.velocity, self.mass, self.inverse_mass);
+            zones.rigidify(
+                self.position,
+                self.velocity,
+                self.mass,
+                self.inverse_mass,
+                self.dt,
+            );
         }
         for &i in self.scratch.zones.members() {
             self.in_contact[i as usize] |= self.inverse_mass[i as usize] > 0.0;

@@ -81,6 +81,7 @@ pub fn collider<'a>(
         velocity,
         mass,
         inverse_mass,
+        groups: &topology.island,
         in_contact,
         settings,
         dt,
@@ -102,7 +103,7 @@ pub fn proximity(
         return;
     }
     let scratch = &mut *scratch;
-    scratch.impulses.begin_step(state.len());
+    scratch.impulses.begin_step(&topology.island);
     let settings = config.impulse_settings();
     let mut collider = collider(
         &mut state,

@@ -10,6 +10,7 @@ use super::projection::{
 use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
 use crate::metrics::{IterationStats, StrandMetrics, count_elements};
+use crate::model::NO_ISLAND;
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
@@ -28,27 +29,38 @@ pub struct Islands {
     /// Islands of a kind the configured solver cannot solve (their edges keep stretch
     /// springs).
     pub unsolved: Vec<usize>,
-    island_of_particle: Vec<u32>,
     touched: Vec<(u32, u32)>,
     rows: Vec<ContactRow>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
+    /// Islands whose latest re-projection with contacts failed (refused as too large,
+    /// or stopped short of the tolerance) this step: their edges are as the impulses
+    /// before it left them.
+    failed: Vec<u32>,
 }
 
 impl Islands {
+    /// Forget the failed re-projections of the previous step.
+    pub fn begin_contact_step(&mut self) {
+        self.failed.clear();
+    }
+
+    /// A particle of every island whose latest re-projection with contacts failed this
+    /// step, into `out`.
+    pub fn failed_particles(&self, out: &mut Vec<u32>) {
+        out.clear();
+        for &i in &self.failed {
+            let edge = &self.set.edges[self.set.islands[i as usize].edges.start];
+            out.push(edge.a);
+            out.push(edge.b);
+        }
+    }
+
     /// Count of islands of `kind` (solved or not).
     pub fn count(&self, kind: IslandKind) -> usize {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
     }
 
-    /// The solved island a particle belongs to, if any.
-    pub fn island_of(&self, particle: usize) -> Option<usize> {
-        self.island_of_particle
-            .get(particle)
-            .copied()
-            .filter(|&i| i != NO_ISLAND)
-            .map(|i| i as usize)
-    }
 
     fn view(&self, island: usize) -> IslandView<'_> {
         let island = &self.set.islands[island];
@@ -103,7 +115,8 @@ impl Islands {
         }
     }
 
-    /// Project again the islands that `contacts` touch, each with its contact rows:
+    /// Project again the islands that `contacts` touch (`island` gives each particle's,
+    /// as [`Topology::island`] does), each with its contact rows:
     /// Gauss–Seidel sweeps over those islands, each solved exactly with the other sides
     /// of its contacts frozen, until no contact falls short by more than the settings'
     /// contact tolerance or `sweeps` are done. Returns the largest shortfall left, as a
@@ -111,6 +124,7 @@ impl Islands {
     #[allow(clippy::too_many_arguments)]
     pub fn project_with_contacts(
         &mut self,
+        island: &[u32],
         bodies: &mut Bodies,
         contacts: &[ContactRow],
         dt: f64,
@@ -123,7 +137,7 @@ impl Islands {
         self.touched.clear();
         for (c, row) in contacts.iter().enumerate() {
             for &p in &row.particles {
-                if let Some(i) = self.island_of(p as usize) {
+                if let Some(i) = island_of(island, p as usize) {
                     self.touched.push((i as u32, c as u32));
                 }
             }
@@ -134,7 +148,7 @@ impl Islands {
             let mut islands = row
                 .particles
                 .iter()
-                .filter_map(|&p| self.island_of(p as usize));
+                .filter_map(|&p| island_of(island, p as usize));
             islands
                 .next()
                 .is_some_and(|first| islands.any(|i| i != first))
@@ -194,10 +208,28 @@ impl Islands {
         );
         stats.record(&outcome);
         self.scratch = scratch;
+        if !contacts.is_empty() {
+            let failed = outcome.rejected || !outcome.converged || outcome.singular;
+            let known = self.failed.iter().position(|&i| i as usize == island);
+            match (failed, known) {
+                (true, None) => self.failed.push(island as u32),
+                (false, Some(slot)) => {
+                    self.failed.swap_remove(slot);
+                }
+                _ => {}
+            }
+        }
     }
 }
 
-const NO_ISLAND: u32 = u32::MAX;
+/// The island of `particle`, if it is in one.
+fn island_of(island: &[u32], particle: usize) -> Option<usize> {
+    island
+        .get(particle)
+        .copied()
+        .filter(|&i| i != NO_ISLAND)
+        .map(|i| i as usize)
+}
 
 /// Islands, the Constrain stage and its settings.
 pub struct ConstraintsPlugin;
@@ -278,15 +310,13 @@ pub fn rebuild_islands(
     }
     islands.scratch.reserve(longest, most_particles);
     islands.relaxation.reserve(topology.pinned.len(), longest);
-    islands.island_of_particle.clear();
-    islands
-        .island_of_particle
-        .resize(topology.pinned.len(), NO_ISLAND);
+    topology.island.clear();
+    topology.island.resize(topology.pinned.len(), NO_ISLAND);
     for &i in &solved {
         for e in &set.edges[set.islands[i].edges.clone()] {
             for p in [e.a as usize, e.b as usize] {
                 if !topology.pinned[p] {
-                    islands.island_of_particle[p] = i as u32;
+                    topology.island[p] = i as u32;
                 }
             }
         }

@@ -14,5 +14,9 @@ pub mod union_find;
 pub mod validate;
 
 pub use edge::{Bend, Edge, bend_count, edge_count};
+
+/// The island of a packed particle that is in none: pinned, or joined by no
+/// constrained edge. Islands are the rigid groups of the collision fail-safe too.
+pub const NO_ISLAND: u32 = u32::MAX;
 pub use point_edge::PointEdgePair;
 pub use union_find::UnionFind;

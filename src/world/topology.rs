@@ -14,7 +14,7 @@ use bevy::ecs::entity::EntityHashMap;
 use bevy::prelude::*;
 
 use crate::model::validate::{StrandError, check_particle, check_strand_shape};
-use crate::model::{Bend, Edge, bend_count};
+use crate::model::{Bend, Edge, NO_ISLAND, bend_count};
 use crate::world::config::StrandsConfig;
 use crate::world::hooks::TopologyDirty;
 use crate::world::particle::{Mass, Particle, Pinned, Position, SolverIndex, Velocity};
@@ -44,6 +44,10 @@ pub struct Topology {
     pub index: EntityHashMap<u32>,
     /// Whether each packed particle is pinned.
     pub pinned: Vec<bool>,
+    /// The solved constraint island of each packed particle, [`NO_ISLAND`] for none;
+    /// set by the constraint plugin after each rebuild. A collision fail-safe zone
+    /// takes in whole islands.
+    pub island: Vec<u32>,
     /// All edges, strand by strand.
     pub edges: Vec<Edge>,
     /// All bending elements.
@@ -207,13 +211,16 @@ pub fn rebuild_topology(world: &mut World) {
             .map_or(SolverIndex::NONE, |&i| SolverIndex(i));
         solver_index.set_if_neq(new);
     }
-    let pinned = order.iter().map(|e| valid[e]).collect();
+    let pinned: Vec<bool> = order.iter().map(|e| valid[e]).collect();
+    let topology_len = pinned.len();
     world.resource_mut::<ParticleState>().resize(order);
     world.insert_resource(problems);
 
     let mut topology = world.resource_mut::<Topology>();
     topology.version += 1;
     topology.index = index;
+    topology.island.clear();
+    topology.island.resize(topology_len, NO_ISLAND);
     topology.pinned = pinned;
     topology.edges = edges;
     topology.bends = bends;
