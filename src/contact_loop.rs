@@ -43,8 +43,8 @@ impl Plugin for ContactLoopPlugin {
 pub struct ContactRows {
     /// The rows.
     pub rows: Vec<ContactRow>,
-    /// A particle of each island whose re-projection failed this step.
-    failed: Vec<u32>,
+    /// Each island projected, and whether it met its edges.
+    outcomes: Vec<(u32, bool)>,
 }
 
 /// The ContactLoop sub-stage: alternate re-projection with contact rows and collision
@@ -72,7 +72,6 @@ pub fn contact_loop(
     };
     let impulse_settings = collisions.impulse_settings();
     let scratch = &mut *scratch;
-    islands.begin_contact_step();
     let mut changed = scratch.outcome.impulses > 0;
     let mut collider = collider(
         &mut state,
@@ -90,35 +89,34 @@ pub fn contact_loop(
             &contact,
             &mut islands,
             &settings,
-            &mut rows.rows,
+            &mut rows,
             &mut metrics,
         );
         let round = collider.resolve_crossings(true);
         changed = round.impulses > 0;
         scratch.outcome.add(round);
     }
-    islands.failed_particles(&mut rows.failed);
-    let unsettled = changed || !rows.failed.is_empty();
+    let unsettled = collider.scratch.any_dirty();
     if unsettled {
-        // Impulses after the last projection, or a projection that failed: rather than
-        // leave the edges next to those contacts stretched, end the step with their
-        // islands rigid.
-        scratch.outcome.add(collider.finish_rigidly(&rows.failed));
+        // Impulses after an island's last good projection (the last round's, or before a
+        // projection that failed): rather than leave those edges stretched, end the step
+        // with the islands rigid.
+        scratch.outcome.add(collider.finish_rigidly());
     }
     metrics.contact_unsettled_steps += u64::from(unsettled);
 }
 
 /// Project the islands the contacts touched onto their constraints again, with the
-/// contacts as rows that must not approach. Particles in rigid impact zones keep their
-/// velocities.
+/// contacts as rows that must not approach, and record which met their edges.
 fn reproject(
     collider: &mut Collider,
     contact: &ContactConfig,
     islands: &mut Islands,
     settings: &ProjectionSettings,
-    rows: &mut Vec<ContactRow>,
+    buffers: &mut ContactRows,
     metrics: &mut StrandMetrics,
 ) {
+    let rows = &mut buffers.rows;
     // Rows: every contact met this step, and every pair already closer than `reach`
     // thicknesses. Each may approach while it ends the step at least `keep` of the
     // thickness apart.
@@ -157,10 +155,7 @@ fn reproject(
             rows.push(row(p, e, alpha, (x - contact_point) / distance));
         }
     }
-    let mut bodies = Bodies {
-        held: Some(collider.scratch.zones.in_zone()),
-        ..Bodies::new(collider.position, collider.velocity, collider.inverse_mass)
-    };
+    let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
     islands.project_with_contacts(
         collider.groups,
         &mut bodies,
@@ -169,5 +164,9 @@ fn reproject(
         settings,
         contact.sweeps,
         &mut metrics.contact_projection,
+        &mut buffers.outcomes,
     );
+    for &(island, met) in &buffers.outcomes {
+        collider.scratch.projected(island, met);
+    }
 }

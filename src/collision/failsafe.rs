@@ -136,6 +136,26 @@ impl ImpactZones {
         changed
     }
 
+    /// Put every particle of rigid group `g` in one zone.
+    pub fn join_group(&mut self, g: u32) {
+        let range = self.group_start[g as usize] as usize..self.group_start[g as usize + 1] as usize;
+        if let Some(&first) = self.group_members.get(range.start) {
+            self.group_joined[g as usize] = true;
+            for slot in range {
+                let j = self.group_members[slot] as usize;
+                self.enter(j);
+                if let Some((keep, merged)) = self.sets.union(first as usize, j) {
+                    self.translation_only[keep] |= self.translation_only[merged];
+                }
+            }
+        }
+    }
+
+    /// The number of rigid groups.
+    pub fn groups(&self) -> usize {
+        self.group_joined.len()
+    }
+
     /// Make the zone of `i` translate only; whether it rotated before.
     pub fn stop_rotation(&mut self, i: usize) -> bool {
         let z = self.zone(i);

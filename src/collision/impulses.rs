@@ -61,8 +61,10 @@ pub struct ImpulseScratch {
     /// The fail-safe's rigid impact zones of this step.
     pub zones: ImpactZones,
     hits: Vec<(u32, u32, u32)>,
-    /// The pairs that took impulses in the latest round of passes.
-    round: Vec<(u32, u32, u32)>,
+    /// The rigid groups (constraint islands) whose velocities impulses changed since
+    /// their last projection met every edge or rigid zone moved them: their edges may
+    /// be stretched.
+    dirty: Vec<bool>,
 }
 
 impl ImpulseScratch {
@@ -72,6 +74,20 @@ impl ImpulseScratch {
         self.contacts.clear();
         self.contact_index.clear();
         self.zones.reset(groups);
+        self.dirty.clear();
+        self.dirty.resize(self.zones.groups(), false);
+    }
+
+    /// Group `group` was projected again: its edges are met if `met`.
+    pub fn projected(&mut self, group: u32, met: bool) {
+        if let Some(dirty) = self.dirty.get_mut(group as usize) {
+            *dirty = !met;
+        }
+    }
+
+    /// Whether some group's edges may be stretched by impulses.
+    pub fn any_dirty(&self) -> bool {
+        self.dirty.iter().any(|&d| d)
     }
 
     /// Whether point `p` met edge `edge` this step.
@@ -195,9 +211,11 @@ impl Collider<'_> {
         };
         // One record per point and edge: the latest contact between them.
         let scratch = &mut *self.scratch;
-        scratch
-            .round
-            .push((pair.p as u32, pair.q as u32, pair.r as u32));
+        for i in [pair.p, pair.q, pair.r] {
+            if let Some(dirty) = scratch.dirty.get_mut(self.groups[i] as usize) {
+                *dirty = true;
+            }
+        }
         let next = scratch.contacts.len() as u32;
         let slot = *scratch
             .contact_index
@@ -321,7 +339,6 @@ impl Collider<'_> {
     /// pairs predate a velocity change.
     pub fn resolve_crossings(&mut self, mut stale: bool) -> CollisionOutcome {
         let mut outcome = CollisionOutcome::default();
-        self.scratch.round.clear();
         for _ in 0..self.settings.max_iterations {
             if stale {
                 self.find_pairs();
@@ -338,18 +355,15 @@ impl Collider<'_> {
         failsafe
     }
 
-    /// End the step rigidly: the islands that took impulses in the latest round of
-    /// passes, and those of the particles in `also`, move as exact rigid zones, merged
-    /// with whatever they still meet, so that no impulse is left stretching an edge. For
-    /// a step whose contacts did not settle.
-    pub fn finish_rigidly(&mut self, also: &[u32]) -> CollisionOutcome {
-        let scratch = &mut *self.scratch;
-        scratch.round.extend(also.iter().map(|&p| (p, p, p)));
+    /// End the step rigidly: every group that impulses left stretched (see
+    /// [`ImpulseScratch::any_dirty`]) moves as an exact rigid zone, merged with whatever
+    /// it still meets. For a step whose contacts did not settle.
+    pub fn finish_rigidly(&mut self) -> CollisionOutcome {
         self.fail_safe(true)
     }
 
-    /// Rigid impact zones until no collision is left, seeded with the latest round's
-    /// pairs when `seeded`.
+    /// Rigid impact zones until no collision is left, seeded with the dirty groups when
+    /// `seeded`.
     fn fail_safe(&mut self, seeded: bool) -> CollisionOutcome {
         let unresolved = self.zones_until_clean(seeded);
         CollisionOutcome {
@@ -362,24 +376,36 @@ impl Collider<'_> {
         }
     }
 
+    /// Move every zone rigidly; a zone's groups are then exact, no longer dirty.
+    fn rigidify_zones(&mut self) {
+        let scratch = &mut *self.scratch;
+        scratch.zones.rigidify(
+            self.position,
+            self.velocity,
+            self.mass,
+            self.inverse_mass,
+            self.dt,
+        );
+        for &i in scratch.zones.members() {
+            if let Some(dirty) = scratch.dirty.get_mut(self.groups[i as usize] as usize) {
+                *dirty = false;
+            }
+        }
+    }
+
     /// Rigid impact zones until no collision is left; returns the number left
     /// unresolved.
     fn zones_until_clean(&mut self, seeded: bool) -> usize {
         let n = self.position.len();
         self.scratch.zones.reset(self.groups);
         if seeded {
-            let zones = &mut self.scratch.zones;
-            for &(p, q, r) in &self.scratch.round {
-                zones.join(p as usize, q as usize, self.groups);
-                zones.join(p as usize, r as usize, self.groups);
+            let scratch = &mut *self.scratch;
+            for g in 0..scratch.dirty.len() {
+                if scratch.dirty[g] {
+                    scratch.zones.join_group(g as u32);
+                }
             }
-            zones.rigidify(
-                self.position,
-                self.velocity,
-                self.mass,
-                self.inverse_mass,
-                self.dt,
-            );
+            self.rigidify_zones();
         }
         for _round in 0..(4 * n + 16) {
             self.find_pairs();
@@ -411,13 +437,7 @@ impl Collider<'_> {
                     return self.scratch.hits.len();
                 }
             }
-            zones.rigidify(
-                self.position,
-                self.velocity,
-                self.mass,
-                self.inverse_mass,
-                self.dt,
-            );
+            self.rigidify_zones();
         }
         for &i in self.scratch.zones.members() {
             self.in_contact[i as usize] |= self.inverse_mass[i as usize] > 0.0;

@@ -33,29 +33,9 @@ pub struct Islands {
     rows: Vec<ContactRow>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
-    /// Islands whose latest re-projection with contacts failed (refused as too large,
-    /// or stopped short of the tolerance) this step: their edges are as the impulses
-    /// before it left them.
-    failed: Vec<u32>,
 }
 
 impl Islands {
-    /// Forget the failed re-projections of the previous step.
-    pub fn begin_contact_step(&mut self) {
-        self.failed.clear();
-    }
-
-    /// A particle of every island whose latest re-projection with contacts failed this
-    /// step, into `out`.
-    pub fn failed_particles(&self, out: &mut Vec<u32>) {
-        out.clear();
-        for &i in &self.failed {
-            let edge = &self.set.edges[self.set.islands[i as usize].edges.start];
-            out.push(edge.a);
-            out.push(edge.b);
-        }
-    }
-
     /// Count of islands of `kind` (solved or not).
     pub fn count(&self, kind: IslandKind) -> usize {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
@@ -119,8 +99,9 @@ impl Islands {
     /// as [`Topology::island`] does), each with its contact rows:
     /// Gauss–Seidel sweeps over those islands, each solved exactly with the other sides
     /// of its contacts frozen, until no contact falls short by more than the settings'
-    /// contact tolerance or `sweeps` are done. Returns the largest shortfall left, as a
-    /// speed.
+    /// contact tolerance or `sweeps` are done. Each island's last projection is told in
+    /// `outcomes` (island, whether it met its edges). Returns the largest shortfall
+    /// left, as a speed.
     #[allow(clippy::too_many_arguments)]
     pub fn project_with_contacts(
         &mut self,
@@ -131,7 +112,9 @@ impl Islands {
         settings: &ProjectionSettings,
         sweeps: u32,
         stats: &mut IterationStats,
+        outcomes: &mut Vec<(u32, bool)>,
     ) -> f64 {
+        outcomes.clear();
         let tolerance = settings.contact_tolerance / dt;
         // Which islands each contact touches, grouped by island.
         self.touched.clear();
@@ -171,7 +154,11 @@ impl Islands {
                     self.rows.push(contacts[c as usize]);
                 }
                 let rows = std::mem::take(&mut self.rows);
-                self.project_island(island as usize, bodies, &rows, dt, settings, stats);
+                let met = self.project_island(island as usize, bodies, &rows, dt, settings, stats);
+                match outcomes.iter_mut().find(|(i, _)| *i == island) {
+                    Some(outcome) => outcome.1 = met,
+                    None => outcomes.push((island, met)),
+                }
                 self.rows = rows;
                 start = end;
             }
@@ -196,7 +183,7 @@ impl Islands {
         dt: f64,
         settings: &ProjectionSettings,
         stats: &mut IterationStats,
-    ) {
+    ) -> bool {
         let mut scratch = std::mem::take(&mut self.scratch);
         let outcome = project_island(
             self.view(island),
@@ -208,17 +195,7 @@ impl Islands {
         );
         stats.record(&outcome);
         self.scratch = scratch;
-        if !contacts.is_empty() {
-            let failed = outcome.rejected || !outcome.converged || outcome.singular;
-            let known = self.failed.iter().position(|&i| i as usize == island);
-            match (failed, known) {
-                (true, None) => self.failed.push(island as u32),
-                (false, Some(slot)) => {
-                    self.failed.swap_remove(slot);
-                }
-                _ => {}
-            }
-        }
+        outcome.converged && !outcome.rejected && !outcome.singular
     }
 }
 

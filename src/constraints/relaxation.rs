@@ -61,7 +61,6 @@ pub fn relax(
         position,
         velocity,
         inverse_mass: w,
-        ..
     } = bodies;
     scratch.reserve(position.len(), edges.len());
     let s = scratch;

@@ -30,8 +30,8 @@
 //! solve per contact column), leaving a small contact-space complementarity problem,
 //! solved by projected Gauss–Seidel. The edge equations hold exactly for any contact
 //! impulses, so lengths are exact whatever the contacts do; the contacts are met to
-//! the complementarity tolerance. Particles outside the island, and particles the
-//! caller holds, keep their velocities. With contacts the end-of-step direction is used, whatever the setting, since the
+//! the complementarity tolerance. Particles outside the island keep their velocities.
+//! With contacts the end-of-step direction is used, whatever the setting, since the
 //! elimination needs the symmetric system.
 //!
 //! A pure kernel: slices in, slices out, no allocation once the scratch is sized. The

@@ -44,13 +44,15 @@ pub(super) fn project_walk<W: Walk>(
     // Iterate on the correction Δ to the predicted motion, x̃ = x + dt v* + Δ, and on
     // edges formed from differences, so that nothing depends on the distance from the
     // origin and v = v* + Δ / dt changes the momentum only by the impulses.
+    let Bodies {
+        position,
+        velocity,
+        inverse_mass,
+    } = bodies;
     for j in 0..particles {
         scratch.correction[j] = DVec2::ZERO;
-        scratch.inverse_mass[j] = bodies.weight(particle(j));
+        scratch.inverse_mass[j] = inverse_mass[particle(j)];
     }
-    let Bodies {
-        position, velocity, ..
-    } = bodies;
     for (k, e) in edges.iter().enumerate() {
         let (a, b) = (e.a as usize, e.b as usize);
         scratch.start_direction[k] = position[b] - position[a];

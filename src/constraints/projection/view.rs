@@ -15,19 +15,15 @@ pub struct Bodies<'a> {
     pub velocity: &'a mut [DVec2],
     /// Inverse masses (0: pinned).
     pub inverse_mass: &'a [f64],
-    /// Particles whose velocity the projection must leave alone (a rigid impact zone's
-    /// members), as if pinned for this solve; `None`: none.
-    pub held: Option<&'a [bool]>,
 }
 
 impl<'a> Bodies<'a> {
-    /// The slices, with nothing held.
+    /// The slices.
     pub fn new(position: &'a [DVec2], velocity: &'a mut [DVec2], inverse_mass: &'a [f64]) -> Self {
         Self {
             position,
             velocity,
             inverse_mass,
-            held: None,
         }
     }
 
@@ -37,17 +33,6 @@ impl<'a> Bodies<'a> {
             position: self.position,
             velocity: &mut *self.velocity,
             inverse_mass: self.inverse_mass,
-            held: self.held,
-        }
-    }
-
-    /// Inverse mass of particle `i` for this solve: 0 if pinned or held.
-    #[inline]
-    pub fn weight(&self, i: usize) -> f64 {
-        if self.held.is_some_and(|held| held[i]) {
-            0.0
-        } else {
-            self.inverse_mass[i]
         }
     }
 }
