@@ -21,7 +21,7 @@ use crate::constraints::projection::{Bodies, ContactRow, ProjectionSettings};
 use crate::metrics::StrandMetrics;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
-use crate::schedule::{CollideSet, StrandsStep};
+use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
 use crate::world::state::ParticleState;
 use crate::world::topology::Topology;
@@ -34,7 +34,13 @@ impl Plugin for ContactLoopPlugin {
         app.init_resource::<ContactConfig>()
             .init_resource::<ContactRows>()
             .register_type::<ContactConfig>()
-            .add_systems(StrandsStep, contact_loop.in_set(CollideSet::ContactLoop));
+            .add_systems(
+                StrandsStep,
+                (
+                    speculate.in_set(ConstrainSet::Speculate),
+                    contact_loop.in_set(CollideSet::ContactLoop),
+                ),
+            );
     }
 }
 
@@ -45,6 +51,103 @@ pub struct ContactRows {
     pub rows: Vec<ContactRow>,
     /// Each island projected, and whether it met its edges.
     outcomes: Vec<(u32, bool)>,
+}
+
+/// The Speculate sub-stage: the points the projected motion would bring within `keep`
+/// of the thickness of an obstacle (an edge that cannot move: walls, pinned edges)
+/// become rows, and their islands are projected again with them, before any impulse. An island whose projection with rows fails is projected alone
+/// again, so that the stage always leaves every edge met.
+#[allow(clippy::too_many_arguments)]
+pub fn speculate(
+    collisions: Res<CollisionConfig>,
+    contact: Res<ContactConfig>,
+    constraints: Res<ConstraintConfig>,
+    step: Res<StrandsConfig>,
+    topology: Res<Topology>,
+    mut islands: ResMut<Islands>,
+    mut state: ResMut<ParticleState>,
+    mut scratch: ResMut<CollisionScratch>,
+    mut buffers: ResMut<ContactRows>,
+    mut metrics: ResMut<StrandMetrics>,
+) {
+    if !(collisions.enabled && constraints.solver.projects_contacts() && contact.speculative) {
+        return;
+    }
+    let settings = ProjectionSettings {
+        max_correction: contact.max_correction,
+        contact_tolerance: contact.tolerance * collisions.thickness,
+        ..constraints.projection()
+    };
+    let impulse_settings = collisions.impulse_settings();
+    let keep = contact.keep * collisions.thickness;
+    let buffers = &mut *buffers;
+    let mut collider = collider(
+        &mut state,
+        &topology,
+        &impulse_settings,
+        step.dt,
+        &mut scratch.impulses,
+    );
+    collider.find_pairs();
+    let (position, velocity, dt) = (collider.position, &*collider.velocity, collider.dt);
+    buffers.rows.clear();
+    let w = collider.inverse_mass;
+    for &(p, k) in &collider.scratch.pairs {
+        let e = &collider.edges[k as usize];
+        // Only against what cannot move (a wall, pinned particles): a row between two
+        // free islands, solved island by island, would push only the first one solved.
+        // Those pairs are left to the impulses, which conserve momentum.
+        let obstacle = w[e.a as usize] == 0.0 && w[e.b as usize] == 0.0;
+        let free_point = w[p as usize] > 0.0;
+        if !(obstacle && free_point) {
+            continue;
+        }
+        let (q, r) = (position[e.a as usize], position[e.b as usize]);
+        let x = position[p as usize];
+        let (alpha, gap) = closest_on_segment(x, q, r);
+        if gap <= 0.0 {
+            continue; // on the edge: the collision stage decides its side
+        }
+        let normal = (x - q.lerp(r, alpha)) / gap;
+        let pair = PointEdgePair {
+            p: p as usize,
+            q: e.a as usize,
+            r: e.b as usize,
+            alpha,
+        };
+        let mut row = ContactRow::point_edge(pair, normal, velocity);
+        if gap + dt * row.target >= keep {
+            continue; // ends the step farther than `keep` along the normal
+        }
+        // Approach allowed down to `keep`; from closer, no further.
+        row.target = if gap >= keep { (keep - gap) / dt } else { 0.0 };
+        buffers.rows.push(row);
+    }
+    if buffers.rows.is_empty() {
+        return;
+    }
+    let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
+    islands.project_with_contacts(
+        collider.groups,
+        &mut bodies,
+        &buffers.rows,
+        dt,
+        &settings,
+        contact.sweeps,
+        &mut metrics.contact_projection,
+        &mut buffers.outcomes,
+    );
+    for &(island, met) in &buffers.outcomes {
+        if !met {
+            islands.project_alone(
+                island as usize,
+                &mut bodies,
+                dt,
+                &constraints.projection(),
+                &mut metrics.projection,
+            );
+        }
+    }
 }
 
 /// The ContactLoop sub-stage: alternate re-projection with contact rows and collision

@@ -141,6 +141,8 @@ pub struct UnresolvedCollision {
     pub particles: [Entity; 3],
     /// Their positions at the start of the step.
     pub positions: [DVec2; 3],
+    /// The moving pinned particle that drove them together, if one did.
+    pub driven_by: Option<Entity>,
 }
 
 /// Two edges found crossing at the end of a step: where and when, and which particles.

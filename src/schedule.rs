@@ -7,7 +7,13 @@
 //!
 //! 1. **Forces** — external forces, gravity, damping, springs, bending, tethers.
 //! 2. **Predict** — symplectic Euler predictor `v* = v + dt f / m`.
-//! 3. **Constrain** — impulses so every constrained edge ends the step at rest length.
+//! 3. **Constrain** — the sub-stages of [`ConstrainSet`], in order:
+//!    1. **Project** — every island's velocities projected so that each constrained
+//!       edge ends the step at its rest length.
+//!    2. **Speculate** — the points that motion would bring within half the cushion
+//!       of a wall or another edge that cannot move become contact rows, and their
+//!       islands are projected again with them: the projection sees those contacts
+//!       before any impulse.
 //! 4. **Collide** — the sub-stages of [`CollideSet`], in order:
 //!    1. **Proximity** — candidate pairs for the step's motion; pairs that would end
 //!       the step closer than the thickness are pushed apart.
@@ -75,6 +81,16 @@ pub enum StepSet {
     Measure,
 }
 
+/// The sub-stages of [`StepSet::Constrain`], in order.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ConstrainSet {
+    /// Every island projected onto its edge constraints.
+    Project,
+    /// Speculative contact rows for the points the projected motion brings close to an
+    /// edge that cannot move, and the islands they touch projected again with them.
+    Speculate,
+}
+
 /// The sub-stages of [`StepSet::Collide`], in order.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CollideSet {
@@ -130,6 +146,12 @@ impl Plugin for SchedulePlugin {
                 StepSet::Measure,
             )
                 .chain(),
+        );
+        app.configure_sets(
+            StrandsStep,
+            (ConstrainSet::Project, ConstrainSet::Speculate)
+                .chain()
+                .in_set(StepSet::Constrain),
         );
         app.configure_sets(
             StrandsStep,

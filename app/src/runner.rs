@@ -369,12 +369,14 @@ fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u6
     }
     if let Some(last) = &metrics.last_unresolved {
         notes.push(format!(
-            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other); the latest at step {}: point {} against the edge {}–{}",
+            "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other); the latest at step {}: point {} against the edge {}–{}{}",
             metrics.unresolved_collisions,
             last.step,
             last.particles[0],
             last.particles[1],
-            last.particles[2]
+            last.particles[2],
+            last.driven_by
+                .map_or(String::new(), |e| format!(", driven by the pinned particle {e}"))
         ));
     }
     let first_crossing = metrics

@@ -13,14 +13,18 @@
 //! rotation and translates. Zones only ever grow or lose their rotation, so the process
 //! ends, and a translating zone has no internal motion left to cross with.
 //!
-//! A zone holding pinned particles moves as they do: with one, it translates with it
-//! and turns about it with the zone's angular momentum; with several, it follows the
-//! rigid motion that best fits theirs (exact when the pins move rigidly together, as
-//! walls and a creature's roots do).
+//! A zone takes in with each group the pinned particles the group's edges hang from
+//! (its anchors), so that those edges are kept too. A zone holding pinned particles
+//! moves as they do — as its anchors do, if it has any, the other pins being only
+//! obstacles it met: with one, it translates with it and turns about it with the zone's
+//! angular momentum; with several, it follows the rigid motion that best fits theirs
+//! (exact when the pins move rigidly together, as walls and a creature's roots do). A
+//! zone whose anchored motion still runs into an obstacle is a collision nothing can
+//! resolve, and is reported as one.
 
 use bevy::math::DVec2;
 
-use crate::model::{NO_ISLAND as NO_GROUP, UnionFind};
+use crate::model::{Edge, NO_ISLAND as NO_GROUP, UnionFind};
 
 /// Zone membership and per-zone sums, reused between steps.
 #[derive(Clone, Debug, Default)]
@@ -32,6 +36,10 @@ pub struct ImpactZones {
     group_start: Vec<u32>,
     group_members: Vec<u32>,
     group_joined: Vec<bool>,
+    anchor_start: Vec<u32>,
+    anchors: Vec<u32>,
+    is_anchor: Vec<bool>,
+    cursor: Vec<u32>,
     sums: Vec<ZoneSums>,
 }
 
@@ -44,6 +52,7 @@ struct ZoneSums {
     pins: u32,
     pin_start: DVec2,
     pin_end: DVec2,
+    anchors: u32,
     angular: f64,
     inertia: f64,
     pin_cross: f64,
@@ -59,16 +68,26 @@ struct RigidMotion {
 }
 
 impl ImpactZones {
-    /// Every particle in a zone of its own; `groups` gives each particle's rigid group
-    /// (constraint island), [`NO_GROUP`] for none.
-    pub fn reset(&mut self, groups: &[u32]) {
-        let particles = groups.len();
+    /// Every one of `particles` particles in a zone of its own.
+    pub fn reset(&mut self, particles: usize) {
         self.sets.reset(particles);
-        for flags in [&mut self.translation_only, &mut self.in_zone] {
+        for flags in [
+            &mut self.translation_only,
+            &mut self.in_zone,
+            &mut self.is_anchor,
+        ] {
             flags.clear();
             flags.resize(particles, false);
         }
         self.members.clear();
+        self.group_joined.clear();
+    }
+
+    /// Learn the rigid groups before zones are joined: `groups` gives each particle's
+    /// (its constraint island), [`NO_GROUP`] for none, and the constrained `edges` with
+    /// one pinned end (`inverse_mass` 0) hang their group from that pin. Only the
+    /// fail-safe needs this, so only it pays for it.
+    pub fn prepare_groups(&mut self, groups: &[u32], edges: &[Edge], inverse_mass: &[f64]) {
         // The members of each group, by counting sort.
         let count = groups
             .iter()
@@ -87,13 +106,65 @@ impl ImpactZones {
         self.group_members.clear();
         self.group_members
             .resize(self.group_start[count] as usize, 0);
-        let mut cursor = self.group_start.clone();
+        let cursor = &mut self.cursor;
+        cursor.clear();
+        cursor.extend_from_slice(&self.group_start);
         for (i, &g) in groups.iter().enumerate().filter(|(_, g)| **g != NO_GROUP) {
             self.group_members[cursor[g as usize] as usize] = i as u32;
             cursor[g as usize] += 1;
         }
         self.group_joined.clear();
         self.group_joined.resize(count, false);
+        // The pins each group hangs from, by counting sort too.
+        let anchor = |e: &Edge| -> Option<(u32, u32)> {
+            let (a, b) = (e.a as usize, e.b as usize);
+            match (inverse_mass[a] == 0.0, inverse_mass[b] == 0.0) {
+                (true, false) if groups[b] != NO_GROUP => Some((groups[b], e.a)),
+                (false, true) if groups[a] != NO_GROUP => Some((groups[a], e.b)),
+                _ => None,
+            }
+        };
+        self.anchor_start.clear();
+        self.anchor_start.resize(count + 1, 0);
+        for (g, _) in edges.iter().filter(|e| e.constrained).filter_map(anchor) {
+            self.anchor_start[g as usize + 1] += 1;
+        }
+        for g in 0..count {
+            self.anchor_start[g + 1] += self.anchor_start[g];
+        }
+        self.anchors.clear();
+        self.anchors.resize(self.anchor_start[count] as usize, 0);
+        let cursor = &mut self.cursor;
+        cursor.clear();
+        cursor.extend_from_slice(&self.anchor_start);
+        for (g, pin) in edges.iter().filter(|e| e.constrained).filter_map(anchor) {
+            self.anchors[cursor[g as usize] as usize] = pin;
+            cursor[g as usize] += 1;
+        }
+    }
+
+    /// Put every particle of group `g`, and the pins it hangs from, in the zone of
+    /// particle `first` of the group.
+    fn take_in_group(&mut self, g: usize, first: usize) {
+        self.group_joined[g] = true;
+        let members = self.group_start[g] as usize..self.group_start[g + 1] as usize;
+        let anchors = self.anchor_start[g] as usize..self.anchor_start[g + 1] as usize;
+        for slot in members {
+            self.take_in(first, self.group_members[slot] as usize);
+        }
+        for slot in anchors {
+            let pin = self.anchors[slot] as usize;
+            self.is_anchor[pin] = true;
+            self.take_in(first, pin);
+        }
+    }
+
+    /// Put `j` in the zone of `first`.
+    fn take_in(&mut self, first: usize, j: usize) {
+        self.enter(j);
+        if let Some((keep, merged)) = self.sets.union(first, j) {
+            self.translation_only[keep] |= self.translation_only[merged];
+        }
     }
 
     /// The zone of particle `i`.
@@ -116,16 +187,8 @@ impl ImpactZones {
             changed |= !self.in_zone[i];
             self.enter(i);
             let g = groups[i];
-            if g != NO_GROUP && !self.group_joined[g as usize] {
-                self.group_joined[g as usize] = true;
-                let range = self.group_start[g as usize] as usize..self.group_start[g as usize + 1] as usize;
-                for slot in range {
-                    let j = self.group_members[slot] as usize;
-                    self.enter(j);
-                    if let Some((keep, merged)) = self.sets.union(i, j) {
-                        self.translation_only[keep] |= self.translation_only[merged];
-                    }
-                }
+            if g != NO_GROUP && self.group_joined.get(g as usize) == Some(&false) {
+                self.take_in_group(g as usize, i);
                 changed = true;
             }
         }
@@ -136,24 +199,13 @@ impl ImpactZones {
         changed
     }
 
-    /// Put every particle of rigid group `g` in one zone.
+    /// Put every particle of rigid group `g`, and the pins it hangs from, in one zone.
     pub fn join_group(&mut self, g: u32) {
-        let range = self.group_start[g as usize] as usize..self.group_start[g as usize + 1] as usize;
-        if let Some(&first) = self.group_members.get(range.start) {
-            self.group_joined[g as usize] = true;
-            for slot in range {
-                let j = self.group_members[slot] as usize;
-                self.enter(j);
-                if let Some((keep, merged)) = self.sets.union(first as usize, j) {
-                    self.translation_only[keep] |= self.translation_only[merged];
-                }
-            }
+        let start = self.group_start[g as usize] as usize;
+        if start < self.group_start[g as usize + 1] as usize && !self.group_joined[g as usize] {
+            let first = self.group_members[start] as usize;
+            self.take_in_group(g as usize, first);
         }
-    }
-
-    /// The number of rigid groups.
-    pub fn groups(&self) -> usize {
-        self.group_joined.len()
     }
 
     /// Make the zone of `i` translate only; whether it rotated before.
@@ -186,14 +238,25 @@ impl ImpactZones {
         self.sums.clear();
         self.sums.resize(n, ZoneSums::default());
         let members = std::mem::take(&mut self.members);
-        // First moments: mass, centre of mass, momentum; the pins' motion apart.
+        // Which pins move each zone: its anchors if it has any, else all its pins.
         for &i in &members {
             let (i, z) = (i as usize, self.zone(i as usize));
+            if inverse_mass[i] == 0.0 && self.is_anchor[i] {
+                self.sums[z].anchors += 1;
+            }
+        }
+        let leads = |sums: &ZoneSums, anchor: bool| sums.anchors == 0 || anchor;
+        // First moments: mass, centre of mass, momentum; the leading pins' motion apart.
+        for &i in &members {
+            let (i, z) = (i as usize, self.zone(i as usize));
+            let leading = leads(&self.sums[z], self.is_anchor[i]);
             let s = &mut self.sums[z];
             if inverse_mass[i] == 0.0 {
-                s.pins += 1;
-                s.pin_start += position[i];
-                s.pin_end += position[i] + dt * velocity[i];
+                if leading {
+                    s.pins += 1;
+                    s.pin_start += position[i];
+                    s.pin_end += position[i] + dt * velocity[i];
+                }
             } else {
                 s.mass += mass[i];
                 s.moment += mass[i] * position[i];
@@ -201,11 +264,14 @@ impl ImpactZones {
             }
         }
         // Second moments: about the centre of mass, or about the pin when there is one;
-        // and the pins' rotation about their centroid.
+        // and the leading pins' rotation about their centroid.
         for &i in &members {
             let (i, z) = (i as usize, self.zone(i as usize));
             let s = self.sums[z];
             if inverse_mass[i] == 0.0 {
+                if !leads(&s, self.is_anchor[i]) {
+                    continue;
+                }
                 let pins = s.pins as f64;
                 let start = position[i] - s.pin_start / pins;
                 let end = position[i] + dt * velocity[i] - s.pin_end / pins;
@@ -307,7 +373,8 @@ mod tests {
         let before = velocity;
         let groups = no_groups(4);
         let mut zones = ImpactZones::default();
-        zones.reset(&groups);
+        zones.reset(groups.len());
+        zones.prepare_groups(&groups, &[], &vec![1.0; groups.len()]);
         assert!(zones.join(0, 1, &groups));
         assert!(zones.join(1, 2, &groups));
         assert!(!zones.join(0, 2, &groups));
@@ -329,7 +396,10 @@ mod tests {
 
         zones.stop_rotation(0);
         zones.rigidify(&position, &mut velocity, &mass, &inverse_mass, dt);
-        assert!((velocity[0] - velocity[2]).length() < 1e-15, "a translating zone");
+        assert!(
+            (velocity[0] - velocity[2]).length() < 1e-15,
+            "a translating zone"
+        );
     }
 
     #[test]
@@ -343,7 +413,8 @@ mod tests {
             .collect();
         let mass = [1.0; 7];
         let mut zones = ImpactZones::default();
-        zones.reset(&groups);
+        zones.reset(groups.len());
+        zones.prepare_groups(&groups, &[], &vec![1.0; groups.len()]);
         zones.join(1, 4, &groups);
         assert_eq!(zones.members().len(), 6);
         assert!(!zones.in_zone()[6]);
@@ -366,18 +437,24 @@ mod tests {
         let mut velocity = [DVec2::new(0.1, 0.0), DVec2::new(-3.0, 2.0)];
         let groups = no_groups(2);
         let mut zones = ImpactZones::default();
-        zones.reset(&groups);
+        zones.reset(groups.len());
+        zones.prepare_groups(&groups, &[], &vec![1.0; groups.len()]);
         zones.join(0, 1, &groups);
         let dt = 0.01;
         zones.rigidify(&position, &mut velocity, &mass, &[0.0, 1.0], dt);
-        assert_eq!(velocity[0], DVec2::new(0.1, 0.0), "the pin keeps its motion");
+        assert_eq!(
+            velocity[0],
+            DVec2::new(0.1, 0.0),
+            "the pin keeps its motion"
+        );
         let end = |i: usize| position[i] + dt * velocity[i];
         assert!((end(0).distance(end(1)) - 1.0).abs() < 1e-14);
         // Two pins standing still (a wall): the zone stops.
         let position = [DVec2::ZERO, DVec2::X, DVec2::new(0.5, 0.1)];
         let mut velocity = [DVec2::ZERO, DVec2::ZERO, DVec2::new(0.0, -4.0)];
         let groups = no_groups(3);
-        zones.reset(&groups);
+        zones.reset(groups.len());
+        zones.prepare_groups(&groups, &[], &vec![1.0; groups.len()]);
         zones.join(2, 0, &groups);
         zones.join(2, 1, &groups);
         zones.rigidify(&position, &mut velocity, &[1.0; 3], &[0.0, 0.0, 1.0], dt);

@@ -16,7 +16,7 @@ use super::failsafe::ImpactZones;
 use super::response::{collision_normal_change, contact_change, repulsion_normal_change};
 use crate::model::geometry::closest_on_segment;
 use crate::model::motion::{displacement, displacements};
-use crate::model::{Edge, PointEdgePair};
+use crate::model::{Edge, NO_ISLAND, PointEdgePair};
 
 /// The collision settings the passes use.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,12 +70,11 @@ pub struct ImpulseScratch {
 impl ImpulseScratch {
     /// Forget the previous step's contacts and zones; `groups` gives each particle's
     /// rigid group (constraint island).
-    pub fn begin_step(&mut self, groups: &[u32]) {
+    pub fn begin_step(&mut self, particles: usize) {
         self.contacts.clear();
         self.contact_index.clear();
-        self.zones.reset(groups);
-        self.dirty.clear();
-        self.dirty.resize(self.zones.groups(), false);
+        self.zones.reset(particles);
+        self.dirty.fill(false);
     }
 
     /// Group `group` was projected again: its edges are met if `met`.
@@ -118,8 +117,9 @@ pub struct CollisionOutcome {
     /// Collisions the fail-safe could not resolve (kinematic particles driven into
     /// each other); 0 in every sound scene.
     pub unresolved: usize,
-    /// The first of them: the point and the edge's two particles (packed indices).
-    pub first_unresolved: Option<[u32; 3]>,
+    /// The first of them: the point and the edge's two particles (packed indices), and
+    /// the moving pinned particle that drove their zone into it, if one did.
+    pub first_unresolved: Option<([u32; 3], Option<u32>)>,
 }
 
 impl CollisionOutcome {
@@ -212,8 +212,12 @@ impl Collider<'_> {
         // One record per point and edge: the latest contact between them.
         let scratch = &mut *self.scratch;
         for i in [pair.p, pair.q, pair.r] {
-            if let Some(dirty) = scratch.dirty.get_mut(self.groups[i] as usize) {
-                *dirty = true;
+            let g = self.groups[i];
+            if g != NO_ISLAND {
+                if scratch.dirty.len() <= g as usize {
+                    scratch.dirty.resize(g as usize + 1, false);
+                }
+                scratch.dirty[g as usize] = true;
             }
         }
         let next = scratch.contacts.len() as u32;
@@ -366,12 +370,26 @@ impl Collider<'_> {
     /// `seeded`.
     fn fail_safe(&mut self, seeded: bool) -> CollisionOutcome {
         let unresolved = self.zones_until_clean(seeded);
+        let first = (unresolved > 0)
+            .then(|| self.scratch.hits.first().copied())
+            .flatten();
+        let first_unresolved = first.map(|(p, q, r)| {
+            // What no impulse and no rigid motion could stop: a pinned particle that
+            // moves, in the zone of the point.
+            let zone = self.scratch.zones.zone(p as usize);
+            let members = self.scratch.zones.members().to_vec();
+            let driven = members.into_iter().find(|&i| {
+                let i = i as usize;
+                self.inverse_mass[i] == 0.0
+                    && self.velocity[i] != DVec2::ZERO
+                    && self.scratch.zones.zone(i) == zone
+            });
+            ([p, q, r], driven)
+        });
         CollisionOutcome {
             failsafe: true,
             unresolved,
-            first_unresolved: (unresolved > 0)
-                .then(|| self.scratch.hits.first().map(|&(p, q, r)| [p, q, r]))
-                .flatten(),
+            first_unresolved,
             ..CollisionOutcome::default()
         }
     }
@@ -397,7 +415,10 @@ impl Collider<'_> {
     /// unresolved.
     fn zones_until_clean(&mut self, seeded: bool) -> usize {
         let n = self.position.len();
-        self.scratch.zones.reset(self.groups);
+        self.scratch.zones.reset(n);
+        self.scratch
+            .zones
+            .prepare_groups(self.groups, self.edges, self.inverse_mass);
         if seeded {
             let scratch = &mut *self.scratch;
             for g in 0..scratch.dirty.len() {

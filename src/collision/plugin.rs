@@ -103,7 +103,7 @@ pub fn proximity(
         return;
     }
     let scratch = &mut *scratch;
-    scratch.impulses.begin_step(&topology.island);
+    scratch.impulses.begin_step(state.len());
     let settings = config.impulse_settings();
     let mut collider = collider(
         &mut state,
@@ -165,20 +165,22 @@ pub fn account_collisions(
     metrics.collisions_last_step = total.impulses;
     metrics.failsafe_steps += u64::from(total.failsafe);
     metrics.unresolved_collisions += total.unresolved as u64;
-    if let Some(particles) = total.first_unresolved {
+    if let Some((particles, driven)) = total.first_unresolved {
         let event = UnresolvedCollision {
             step: clock.steps + 1,
             particles: particles.map(|i| state.entity[i as usize]),
             positions: particles.map(|i| state.position[i as usize]),
+            driven_by: driven.map(|i| state.entity[i as usize]),
         };
         warn!(
             "bevy_strands: step {}: {} collision(s) left unresolved, kinematic particles driven \
-             through each other; the first: point {} against the edge {}–{}",
+             through each other; the first: point {} against the edge {}–{}, driven by {:?}",
             event.step,
             total.unresolved,
             event.particles[0],
             event.particles[1],
-            event.particles[2]
+            event.particles[2],
+            event.driven_by
         );
         metrics.last_unresolved = Some(event);
     }

@@ -11,7 +11,7 @@ use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
 use crate::metrics::{IterationStats, StrandMetrics, count_elements};
 use crate::model::NO_ISLAND;
-use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
+use crate::schedule::{ConstrainSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
@@ -41,7 +41,6 @@ impl Islands {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
     }
 
-
     fn view(&self, island: usize) -> IslandView<'_> {
         let island = &self.set.islands[island];
         let edges = &self.set.edges[island.edges.clone()];
@@ -69,6 +68,18 @@ impl Islands {
             let i = self.solved[slot];
             self.project_island(i, bodies, &[], dt, settings, stats);
         }
+    }
+
+    /// Project island `island` alone, with no contact rows; whether it met its edges.
+    pub fn project_alone(
+        &mut self,
+        island: usize,
+        bodies: &mut Bodies,
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) -> bool {
+        self.project_island(island, bodies, &[], dt, settings, stats)
     }
 
     /// Relax every solved island (the Constrain stage of the baseline solvers),
@@ -223,7 +234,7 @@ impl Plugin for ConstraintsPlugin {
                     .after(rebuild_topology)
                     .before(count_elements),
             )
-            .add_systems(StrandsStep, solve_constraints.in_set(StepSet::Constrain));
+            .add_systems(StrandsStep, solve_constraints.in_set(ConstrainSet::Project));
     }
 }
 
