@@ -51,6 +51,10 @@ pub struct ContactRows {
     pub rows: Vec<ContactRow>,
     /// Each island projected, and whether it met its edges.
     outcomes: Vec<(u32, bool)>,
+    /// The edges that cannot move (static: both ends pinned), for the topology version
+    /// in `obstacles_version`.
+    obstacles: Vec<u32>,
+    obstacles_version: Option<u64>,
 }
 
 /// The Speculate sub-stage: the points the projected motion would bring within `keep`
@@ -88,20 +92,25 @@ pub fn speculate(
         step.dt,
         &mut scratch.impulses,
     );
-    collider.find_pairs();
+    // Only against what cannot move (walls, pinned edges): a row between two free
+    // islands, solved island by island, would push only the first one solved. Those
+    // pairs are left to the impulses, which conserve momentum.
+    if buffers.obstacles_version != Some(topology.version) {
+        buffers.obstacles.clear();
+        let edges = topology.edges.iter().enumerate();
+        buffers
+            .obstacles
+            .extend(edges.filter(|(_, e)| e.is_static).map(|(k, _)| k as u32));
+        buffers.obstacles_version = Some(topology.version);
+    }
+    if buffers.obstacles.is_empty() {
+        return;
+    }
+    collider.find_pairs_against(&buffers.obstacles);
     let (position, velocity, dt) = (collider.position, &*collider.velocity, collider.dt);
     buffers.rows.clear();
-    let w = collider.inverse_mass;
     for &(p, k) in &collider.scratch.pairs {
         let e = &collider.edges[k as usize];
-        // Only against what cannot move (a wall, pinned particles): a row between two
-        // free islands, solved island by island, would push only the first one solved.
-        // Those pairs are left to the impulses, which conserve momentum.
-        let obstacle = w[e.a as usize] == 0.0 && w[e.b as usize] == 0.0;
-        let free_point = w[p as usize] > 0.0;
-        if !(obstacle && free_point) {
-            continue;
-        }
         let (q, r) = (position[e.a as usize], position[e.b as usize]);
         let x = position[p as usize];
         let (alpha, gap) = closest_on_segment(x, q, r);

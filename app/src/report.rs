@@ -124,6 +124,8 @@ pub struct Report {
     pub wall_seconds: f64,
     /// Particles × steps per wall-clock second.
     pub particle_steps_per_second: f64,
+    /// Simulated seconds per wall-clock second (above 1: faster than real time).
+    pub real_time_factor: f64,
     /// What a reader must know to interpret the figures.
     pub notes: Vec<String>,
     /// Problems found in the input, and what was done about them.
@@ -199,6 +201,7 @@ impl Report {
                 "particle_steps_per_second",
                 format!("{:.3e}", self.particle_steps_per_second),
             ),
+            ("real_time_factor", format!("{:.3}", self.real_time_factor)),
         ];
         let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
         let mut out = String::new();

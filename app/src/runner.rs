@@ -22,7 +22,7 @@ use crate::scenes::ScenesPlugin;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
 use crate::snapshot::{RunSnapshot, RunSnapshotError};
 use crate::spawn::spawn_scenario;
-use bevy_strands::world::snapshot::SnapshotError;
+use bevy_strands::snapshot::SnapshotError;
 
 /// What to run, and the command line's overrides of the scene.
 #[derive(Clone, Debug, Default)]
@@ -232,6 +232,7 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         ));
     }
     let mut snapshot_due = options.snapshot_at.zip(options.snapshot.clone());
+    let start_time = world.resource::<SimulationClock>().time;
     if options.plot.is_some() {
         world.init_resource::<LengthErrorHistory>();
     }
@@ -297,7 +298,8 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
             "the spaghetti factory's inlet was blocked for {blocked} ticks: its rollers stood still"
         ));
     }
-    let mut report = report(world, &scene, wall_seconds, particle_steps);
+    let simulated = world.resource::<SimulationClock>().time - start_time;
+    let mut report = report(world, &scene, wall_seconds, particle_steps, simulated);
     report.notes.splice(0..0, notes);
     if let Some(recorder) = recorder {
         let frames = recorder.finish()?;
@@ -317,7 +319,13 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
     Ok(report)
 }
 
-fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u64) -> Report {
+fn report(
+    world: &World,
+    scene: &Scenario,
+    wall_seconds: f64,
+    particle_steps: u64,
+    simulated: f64,
+) -> Report {
     let metrics = world.resource::<StrandMetrics>();
     let clock = world.resource::<SimulationClock>();
     let solver = world.resource::<ConstraintConfig>().solver;
@@ -416,6 +424,11 @@ fn report(world: &World, scene: &Scenario, wall_seconds: f64, particle_steps: u6
         wall_seconds,
         particle_steps_per_second: if wall_seconds > 0.0 {
             particle_steps as f64 / wall_seconds
+        } else {
+            0.0
+        },
+        real_time_factor: if wall_seconds > 0.0 {
+            simulated / wall_seconds
         } else {
             0.0
         },
