@@ -44,6 +44,7 @@ pub mod model;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod schedule;
+pub mod snapshot;
 pub mod world;
 
 use bevy::app::PluginGroupBuilder;

@@ -52,7 +52,8 @@ pub struct StrandsStep;
 /// The phases of a tick, in order.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TickSet {
-    /// Scene logic that spawns, despawns or drives particles (factories, tools).
+    /// Scene logic that spawns, despawns or drives particles (factories, tools); not
+    /// run by a tick that only synchronises.
     Prepare,
     /// Rebuild the topology and derived caches if anything structural changed.
     Topology,
@@ -135,6 +136,8 @@ impl Plugin for SchedulePlugin {
             )
                 .chain(),
         );
+        // Scene logic follows simulated time: a paused tick does not run it.
+        app.configure_sets(StrandsTick, TickSet::Prepare.run_if(stepping));
         app.configure_sets(
             StrandsStep,
             (
@@ -207,6 +210,16 @@ fn drive_tick(world: &mut World) {
     let paused = world.resource::<StrandsConfig>().paused;
     world.insert_resource(SyncOnly(paused));
     world.run_schedule(StrandsTick);
+    world.insert_resource(SyncOnly(false));
+}
+
+/// Run a tick that only synchronises: the topology rebuilt and the packed state
+/// gathered from the entities, as at the end of a tick, without a step and without the
+/// scene logic of [`TickSet::Prepare`]. Does nothing in a world without the schedule.
+pub fn synchronise(world: &mut World) {
+    world.insert_resource(SyncOnly(true));
+    // Err only when the schedule does not exist: then there is nothing to synchronise.
+    let _ = world.try_run_schedule(StrandsTick);
     world.insert_resource(SyncOnly(false));
 }
 

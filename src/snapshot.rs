@@ -12,6 +12,7 @@ use bevy::ecs::entity::EntityHashMap;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::schedule::synchronise;
 use crate::world::clock::SimulationClock;
 use crate::world::particle::{ExternalForce, Mass, Particle, Pinned, Position, Velocity};
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
@@ -272,6 +273,9 @@ impl StrandsSnapshot {
             });
         }
         *world.resource_mut::<SimulationClock>() = self.clock;
+        // Scene logic at the start of the next tick reads the topology and the packed
+        // state as the last tick left them: build them now, as that tick would have.
+        synchronise(world);
         let restored = SnapshotEntities { particles, strands };
         if !(restored.particles.is_sorted() && restored.strands.is_sorted()) {
             warn!(

@@ -4,6 +4,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
+use bevy_strands::snapshot::StrandsSnapshot;
 use bevy_strands_app::fixtures::*;
 
 fn spawn_particle(app: &mut App, x: DVec2, v: DVec2) -> Entity {
@@ -335,4 +336,49 @@ fn a_paused_app_keeps_its_state_and_shows_edits() {
     // The paused ticks still synchronised: the new particle is in the packed state.
     let state = app.world().resource::<ParticleState>();
     assert_eq!(state.position, vec![DVec2::new(0.5, 0.5)]);
+}
+
+/// What a Prepare-phase system sees at the start of the next tick: how many edges the
+/// topology has and where the first packed particle is.
+#[derive(Resource, Default)]
+struct SeenAtPrepare(Vec<(usize, Option<DVec2>)>);
+
+fn record_prepare(
+    topology: Res<Topology>,
+    state: Res<ParticleState>,
+    mut seen: ResMut<SeenAtPrepare>,
+) {
+    let first = state.position.first().copied();
+    seen.0.push((topology.edges.len(), first));
+}
+
+fn recording_app() -> App {
+    let mut app = app();
+    app.init_resource::<SeenAtPrepare>()
+        .add_systems(StrandsTick, record_prepare.in_set(TickSet::Prepare));
+    app
+}
+
+#[test]
+fn a_restored_world_is_synchronised_before_its_first_tick() {
+    // Scene logic (an inlet checking whether it is blocked) runs before the topology
+    // rebuild of its tick and reads what the last tick left: a restored world must
+    // offer the same, or the restored run takes another course from its first tick.
+    let mut app = recording_app();
+    spawn_box(&mut app);
+    StrandBuilder::line(DVec2::new(0.3, 0.6), DVec2::X, 12, 0.03)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    ticks(&mut app, 20);
+    let (snapshot, _) = StrandsSnapshot::capture(app.world_mut());
+
+    let mut restored = recording_app();
+    snapshot.restore(restored.world_mut()).unwrap();
+    for other in [&mut app, &mut restored] {
+        ticks(other, 10);
+    }
+    let seen = |app: &App| app.world().resource::<SeenAtPrepare>().0.clone();
+    assert_eq!(seen(&restored), seen(&app)[20..]);
+    let positions = |app: &App| app.world().resource::<ParticleState>().position.clone();
+    assert_eq!(positions(&restored), positions(&app));
 }

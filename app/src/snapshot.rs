@@ -8,7 +8,7 @@ use std::path::Path;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::metrics::StrandMetrics;
-use bevy_strands::world::snapshot::{SnapshotEntities, SnapshotError, StrandsSnapshot};
+use bevy_strands::snapshot::{SnapshotEntities, SnapshotError, StrandsSnapshot};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 

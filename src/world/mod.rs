@@ -4,8 +4,7 @@
 //! [`builder`] and edited by [`edit`]; component [`hooks`] mark the [`topology`] for a
 //! rebuild, which packs the simulated particles into the arrays of [`state`] that the
 //! stages run on ([`sync`] copies between the two). [`config`] holds every setting,
-//! [`clock`] the simulated time and [`problems`] what was refused and why; a
-//! [`snapshot`] captures the simulated state and restores it elsewhere.
+//! [`clock`] the simulated time and [`problems`] what was refused and why.
 
 pub mod builder;
 pub mod clock;
@@ -14,7 +13,6 @@ pub mod edit;
 pub mod hooks;
 pub mod particle;
 pub mod problems;
-pub mod snapshot;
 pub mod state;
 pub mod strand;
 pub mod sync;
