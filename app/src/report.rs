@@ -135,6 +135,13 @@ pub struct Report {
 }
 
 impl Report {
+    /// The fields measured by the wall clock: they differ between identical runs.
+    pub const WALL_CLOCK_FIELDS: [&'static str; 3] = [
+        "wall_seconds",
+        "particle_steps_per_second",
+        "real_time_factor",
+    ];
+
     /// The report as pretty JSON.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a report always serializes")

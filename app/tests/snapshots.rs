@@ -30,12 +30,10 @@ fn run_ok(options: &RunOptions) -> Report {
 fn figures(report: &Report) -> serde_json::Value {
     let mut value = serde_json::to_value(report).unwrap();
     let object = value.as_object_mut().unwrap();
-    for key in [
-        "wall_seconds",
-        "particle_steps_per_second",
-        "notes",
-        "config",
-    ] {
+    for key in Report::WALL_CLOCK_FIELDS
+        .into_iter()
+        .chain(["notes", "config"])
+    {
         object.remove(key);
     }
     value
