@@ -313,3 +313,48 @@ fn a_blocked_inlet_stops_the_factory_instead_of_pushing_through() {
         report.max_rel_length_error
     );
 }
+
+#[test]
+fn no_edge_is_born_across_a_strand_that_moves_with_the_extrusion() {
+    // A free strand crossing the extrusion's path upstream of the inlet, moving at the
+    // extrusion's speed: it keeps ahead of the held particles, so it never blocks the
+    // stretch they sweep, but it passes the inlet between two emissions and would lie
+    // across the next edge when it is born.
+    let scene = r#"(
+        name: "edge_born_across",
+        duration: 0.3,
+        step: (gravity: (0.0, 0.0)),
+        strands: [(
+            shape: Line(start: (1.01, 0.45), angle_degrees: 90.0, particles: 6, spacing: 0.02),
+            velocity: (-1.0, 0.0),
+        )],
+        spaghetti_factory: Some((
+            inlet: (0.99, 0.5),
+            velocity: (-1.0, 0.0),
+            interval: 0.05,
+            particles_per_strand: 13,
+        )),
+    )"#;
+    let file = scratch("edge_born_across.ron");
+    std::fs::write(&file, scene).unwrap();
+    let report = run_ok(&RunOptions {
+        scene_file: Some(file),
+        ..options("edge_born_across", 0.3)
+    });
+    assert_eq!(
+        report.edge_crossings,
+        Some(0),
+        "{:?}",
+        report.first_crossing
+    );
+    assert!(
+        report.notes.iter().any(|n| n.contains("inlet was blocked")),
+        "{:?}",
+        report.notes
+    );
+    assert!(
+        report.max_rel_length_error < 1e-9,
+        "{:e}",
+        report.max_rel_length_error
+    );
+}

@@ -162,10 +162,13 @@ pub fn run_spaghetti_factories(
     }
 }
 
-/// Whether an edge of another strand lies within `reach` of the stretch the held
-/// particles sweep in the coming tick (from the inlet to a tick past the oldest held
-/// particle) and is not moving on ahead of them: the tail of the strand just finished,
-/// leaving at the inlet's speed, is no obstacle; a pile grown up to the inlet is.
+/// Whether the inlet must stand still this tick: an edge lies within half of `reach`
+/// (the thickness) of the stretch from the inlet to the oldest held particle, where the
+/// next edge will appear; or an edge of another strand lies within `reach` of the
+/// stretch the held particles sweep in the coming tick (from the inlet to a tick past
+/// the oldest held particle) and is not moving on ahead of them: the tail of the strand
+/// just finished, leaving at the inlet's speed, is no obstacle; a pile grown up to the
+/// inlet is.
 fn inlet_blocked(
     factory: &SpaghettiFactory,
     tick: f64,
@@ -193,17 +196,25 @@ fn inlet_blocked(
     let speed = spec.velocity.length();
     let ahead = spec.velocity / speed;
     let keeps_ahead = |i: usize| state.velocity[i].dot(ahead) >= 0.5 * speed;
-    // Walls cannot move into the inlet; only what the pile brings up can block it.
+    let clearance = 0.5 * reach;
     topology.edges.iter().any(|e| {
         let (a, b) = (e.a as usize, e.b as usize);
+        if a >= state.position.len() || b >= state.position.len() || is_held(e.a) || is_held(e.b) {
+            return false;
+        }
+        let (p, q) = (state.position[a], state.position[b]);
+        // A new edge is born between the newest held particle and the inlet: nothing may
+        // lie across that stretch or within the thickness of it, moving or not, or the
+        // strand is made crossing.
+        if segment_distance(spec.inlet, lead, p, q) < clearance {
+            return true;
+        }
+        // What the pile brings up into the coming tick's stretch blocks it; walls cannot
+        // move into it, and the tail of the strand just finished moves on ahead.
         !e.is_static
             && Some(e.strand as usize) != own
-            && a < state.position.len()
-            && b < state.position.len()
-            && !is_held(e.a)
-            && !is_held(e.b)
             && !(keeps_ahead(a) && keeps_ahead(b))
-            && segment_distance(from, to, state.position[a], state.position[b]) < reach
+            && segment_distance(from, to, p, q) < reach
     })
 }
 
