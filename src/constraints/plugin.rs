@@ -3,6 +3,7 @@
 
 use bevy::prelude::*;
 
+use super::island_edge::IslandEdge;
 use super::islands::{IslandKind, IslandSet, find_islands};
 use super::projection::{
     Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, ProjectionSettings, project_island,
@@ -11,6 +12,7 @@ use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
 use crate::metrics::{IterationStats, StrandMetrics, count_elements};
 use crate::model::NO_ISLAND;
+use crate::model::union_find::UnionFind;
 use crate::schedule::{ConstrainSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
@@ -30,6 +32,12 @@ pub struct Islands {
     /// springs).
     pub unsolved: Vec<usize>,
     touched: Vec<(u32, u32)>,
+    units: UnionFind,
+    /// (unit, island) of every island a contact touches, by unit.
+    members: Vec<(u32, u32)>,
+    row_ids: Vec<u32>,
+    unit_rows: Vec<u32>,
+    group_edges: Vec<IslandEdge>,
     rows: Vec<ContactRow>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
@@ -39,6 +47,19 @@ impl Islands {
     /// Count of islands of `kind` (solved or not).
     pub fn count(&self, kind: IslandKind) -> usize {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
+    }
+
+    /// Whether contact rows among particles of `islands` (each particle's island, or
+    /// `NO_ISLAND` for a pinned one) can be projected as one unit: they touch at most
+    /// one free island, or only paths.
+    pub fn one_unit(&self, islands: [u32; 3]) -> bool {
+        let mut free = islands.into_iter().filter(|&i| i != NO_ISLAND);
+        let Some(first) = free.next() else {
+            return true;
+        };
+        let is_path = |i: u32| self.set.islands[i as usize].kind == IslandKind::Path;
+        let mut rest = free.filter(|&i| i != first).peekable();
+        rest.peek().is_none() || (is_path(first) && rest.all(is_path))
     }
 
     fn view(&self, island: usize) -> IslandView<'_> {
@@ -127,7 +148,79 @@ impl Islands {
     ) -> f64 {
         outcomes.clear();
         let tolerance = settings.contact_tolerance / dt;
-        // Which islands each contact touches, grouped by island.
+        self.form_units(island, contacts);
+        let crosses_units = contacts.iter().any(|row| {
+            let mut units = row
+                .particles
+                .iter()
+                .filter_map(|&p| island_of(island, p as usize))
+                .map(|i| self.units.find(i));
+            units.next().is_some_and(|first| units.any(|u| u != first))
+        });
+        let mut shortfall = contacts
+            .iter()
+            .map(|row| row.target - row.normal_velocity(bodies.velocity))
+            .fold(0.0, f64::max);
+        for _ in 0..sweeps {
+            let mut start = 0;
+            while start < self.members.len() {
+                let unit = self.members[start].0;
+                let end = start
+                    + self.members[start..]
+                        .iter()
+                        .take_while(|t| t.0 == unit)
+                        .count();
+                // The unit's rows: every contact touching one of its islands, once.
+                self.rows.clear();
+                self.row_ids.clear();
+                for &(_, member) in &self.members[start..end] {
+                    let from = self.touched.partition_point(|t| t.0 < member);
+                    for &(i, c) in &self.touched[from..] {
+                        if i != member {
+                            break;
+                        }
+                        self.row_ids.push(c);
+                    }
+                }
+                self.row_ids.sort_unstable();
+                self.row_ids.dedup();
+                for &c in &self.row_ids {
+                    self.rows.push(contacts[c as usize]);
+                }
+                let rows = std::mem::take(&mut self.rows);
+                let met = if end - start == 1 {
+                    self.project_island(unit as usize, bodies, &rows, dt, settings, stats)
+                } else {
+                    self.project_group(start..end, bodies, &rows, dt, settings, stats)
+                };
+                for &(_, member) in &self.members[start..end] {
+                    match outcomes.iter_mut().find(|(i, _)| *i == member) {
+                        Some(outcome) => outcome.1 = met,
+                        None => outcomes.push((member, met)),
+                    }
+                }
+                self.rows = rows;
+                start = end;
+            }
+            shortfall = contacts
+                .iter()
+                .map(|row| row.target - row.normal_velocity(bodies.velocity))
+                .fold(0.0, f64::max);
+            // Each unit met its own contacts exactly; only contacts between units can
+            // have been disturbed since.
+            if !crosses_units || shortfall <= tolerance {
+                break;
+            }
+        }
+        shortfall
+    }
+
+    /// Which islands `contacts` touch, and the units they are projected in: paths that
+    /// touch each other are one unit, solved as one problem (their systems side by
+    /// side, the contact rows between them eliminated together), as long as the unit's
+    /// rows stay within [`UNIT_ROWS`]; a loop, tree or graph is a unit of its own. Units meet
+    /// each other's contacts by the sweeps of block Gauss–Seidel.
+    fn form_units(&mut self, island: &[u32], contacts: &[ContactRow]) {
         self.touched.clear();
         for (c, row) in contacts.iter().enumerate() {
             for &p in &row.particles {
@@ -138,52 +231,80 @@ impl Islands {
         }
         self.touched.sort_unstable();
         self.touched.dedup();
-        let crosses_islands = contacts.iter().any(|row| {
-            let mut islands = row
+        self.units.reset(self.set.islands.len());
+        // Rows touching each unit (an upper bound: a row between two counts twice). The
+        // unit's dense contact problem costs about the cube of its rows, and in a pile
+        // units of 64 rows came out faster than larger ones, with fewer fail-safe steps.
+        self.unit_rows.clear();
+        self.unit_rows.resize(self.set.islands.len(), 0);
+        for &(i, _) in &self.touched {
+            self.unit_rows[i as usize] += 1;
+        }
+        let is_path = |i: usize| self.set.islands[i].kind == IslandKind::Path;
+        for row in contacts {
+            let mut paths = row
                 .particles
                 .iter()
-                .filter_map(|&p| island_of(island, p as usize));
-            islands
-                .next()
-                .is_some_and(|first| islands.any(|i| i != first))
-        });
-        let mut shortfall = contacts
-            .iter()
-            .map(|row| row.target - row.normal_velocity(bodies.velocity))
-            .fold(0.0, f64::max);
-        for _ in 0..sweeps {
-            let mut start = 0;
-            while start < self.touched.len() {
-                let island = self.touched[start].0;
-                let end = start
-                    + self.touched[start..]
-                        .iter()
-                        .take_while(|t| t.0 == island)
-                        .count();
-                self.rows.clear();
-                for &(_, c) in &self.touched[start..end] {
-                    self.rows.push(contacts[c as usize]);
+                .filter_map(|&p| island_of(island, p as usize))
+                .filter(|&i| is_path(i));
+            if let Some(first) = paths.next() {
+                for other in paths {
+                    let (a, b) = (self.units.find(first), self.units.find(other));
+                    let joined = self.unit_rows[a] + self.unit_rows[b];
+                    if a != b && joined as usize <= UNIT_ROWS {
+                        self.units.union(a, b);
+                        self.unit_rows[a.min(b)] = joined;
+                    }
                 }
-                let rows = std::mem::take(&mut self.rows);
-                let met = self.project_island(island as usize, bodies, &rows, dt, settings, stats);
-                match outcomes.iter_mut().find(|(i, _)| *i == island) {
-                    Some(outcome) => outcome.1 = met,
-                    None => outcomes.push((island, met)),
-                }
-                self.rows = rows;
-                start = end;
-            }
-            shortfall = contacts
-                .iter()
-                .map(|row| row.target - row.normal_velocity(bodies.velocity))
-                .fold(0.0, f64::max);
-            // Each island met its own contacts exactly; only contacts between islands
-            // can have been disturbed since.
-            if !crosses_islands || shortfall <= tolerance {
-                break;
             }
         }
-        shortfall
+        self.members.clear();
+        let mut previous = u32::MAX;
+        for t in 0..self.touched.len() {
+            let i = self.touched[t].0;
+            if i != previous {
+                let unit = self.units.find(i as usize) as u32;
+                self.members.push((unit, i));
+                previous = i;
+            }
+        }
+        // A unit's islands in order, the unit named by its smallest island.
+        self.members.sort_unstable();
+    }
+
+    /// Project the paths `self.members[members]` together with `contacts`: one open
+    /// chain through all of them, consecutive paths joined by a locked gap edge that
+    /// couples nothing; whether every path met its edges.
+    fn project_group(
+        &mut self,
+        members: std::ops::Range<usize>,
+        bodies: &mut Bodies,
+        contacts: &[ContactRow],
+        dt: f64,
+        settings: &ProjectionSettings,
+        stats: &mut IterationStats,
+    ) -> bool {
+        self.group_edges.clear();
+        for &(_, member) in &self.members[members] {
+            let edges = &self.set.edges[self.set.islands[member as usize].edges.clone()];
+            if let (Some(last), Some(first)) = (self.group_edges.last(), edges.first()) {
+                self.group_edges.push(IslandEdge::gap(last.b, first.a));
+            }
+            self.group_edges.extend_from_slice(edges);
+        }
+        let unit = IslandView::Chain(Chain {
+            edges: &self.group_edges,
+            closed: false,
+        });
+        project_met(
+            unit,
+            bodies,
+            contacts,
+            dt,
+            settings,
+            &mut self.scratch,
+            stats,
+        )
     }
 
     fn project_island(
@@ -196,19 +317,31 @@ impl Islands {
         stats: &mut IterationStats,
     ) -> bool {
         let mut scratch = std::mem::take(&mut self.scratch);
-        let outcome = project_island(
-            self.view(island),
-            bodies.reborrow(),
-            contacts,
-            dt,
-            settings,
-            &mut scratch,
-        );
-        stats.record(&outcome);
+        let view = self.view(island);
+        let met = project_met(view, bodies, contacts, dt, settings, &mut scratch, stats);
         self.scratch = scratch;
-        outcome.converged && !outcome.rejected && !outcome.singular
+        met
     }
 }
+
+/// Project `view`, record the solve, and tell whether it met its edges.
+fn project_met(
+    view: IslandView,
+    bodies: &mut Bodies,
+    contacts: &[ContactRow],
+    dt: f64,
+    settings: &ProjectionSettings,
+    scratch: &mut IslandScratch,
+    stats: &mut IterationStats,
+) -> bool {
+    let outcome = project_island(view, bodies.reborrow(), contacts, dt, settings, scratch);
+    stats.record(&outcome);
+    outcome.converged && !outcome.rejected && !outcome.singular
+}
+
+/// The most contact rows paths are joined into one unit for (an island alone may take
+/// up to [`MAX_CONTACT_ROWS`](super::projection::MAX_CONTACT_ROWS)).
+const UNIT_ROWS: usize = 64;
 
 /// The island of `particle`, if it is in one.
 fn island_of(island: &[u32], particle: usize) -> Option<usize> {

@@ -6,7 +6,7 @@
 use super::contact_rows::row_change;
 use super::scratch::IslandScratch;
 use super::walk::Walk;
-use crate::constraints::complementarity::projected_gauss_seidel;
+use crate::constraints::complementarity::{active_set, projected_gauss_seidel};
 
 /// With `s.rhs` holding `A⁻¹(−C)` and the factor kept, solve for the contact impulses
 /// (`s.impulse`) and subtract their effect from the edge multipliers in `s.rhs`.
@@ -75,13 +75,17 @@ pub(super) fn eliminate_contacts<W: Walk>(
             }
         }
     }
-    projected_gauss_seidel(
-        &s.schur[..rows * rows],
-        &s.offset[..rows],
-        0.1 * contact_tolerance,
-        &mut s.impulse[..rows],
-        &mut s.contact_residual[..rows],
-    );
+    // Pivoting solves the contact problem to round-off, so the edges' polish starts
+    // from contacts met exactly; a degenerate problem on which it stalls is iterated,
+    // and so is a projection that pivoting made ask for absurd corrections.
+    let (schur, offset) = (&s.schur[..rows * rows], &s.offset[..rows]);
+    let tolerance = 0.1 * contact_tolerance;
+    let (mu, residual) = (&mut s.impulse[..rows], &mut s.contact_residual[..rows]);
+    if !s.exact_contacts
+        || active_set(schur, offset, tolerance, mu, residual, &mut s.pivoting).is_err()
+    {
+        projected_gauss_seidel(schur, offset, tolerance, mu, residual);
+    }
     // λ = A⁻¹(−C) − Y μ.
     for k in 0..m {
         let row = &s.solved_columns[k * rows..(k + 1) * rows];

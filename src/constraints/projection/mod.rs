@@ -28,9 +28,10 @@
 //! the point's velocity minus the edge's at the contact point, along the normal).
 //! Each Newton step eliminates the edge unknowns through the island's factor (one
 //! solve per contact column), leaving a small contact-space complementarity problem,
-//! solved by projected Gauss–Seidel. The edge equations hold exactly for any contact
-//! impulses, so lengths are exact whatever the contacts do; the contacts are met to
-//! the complementarity tolerance. Particles outside the island keep their velocities.
+//! solved exactly by active-set pivoting (projected Gauss–Seidel finishes the
+//! projections pivoting does not settle). The edge equations hold exactly for any
+//! contact impulses, so lengths are exact whatever the contacts do; the contacts are
+//! met to the complementarity tolerance. Particles outside the island keep their velocities.
 //! With contacts the end-of-step direction is used, whatever the setting, since the
 //! elimination needs the symmetric system.
 //!
@@ -567,5 +568,63 @@ mod tests {
             let polish = POLISH_RESIDUAL * 0.02 / case.dt;
             assert!(contact.normal_velocity(&v) >= contact.target - polish);
         }
+    }
+
+    #[test]
+    fn two_strands_in_contact_projected_together_meet_it_and_keep_their_momentum() {
+        // The two strands of the test above as one unit: one chain through both, joined
+        // by a locked gap edge. The contact impulse acts on both, equal and opposite,
+        // so the pair's momentum is what the predictor gave it.
+        let mut points: Vec<DVec2> = (0..5)
+            .map(|i| DVec2::new(0.43, 0.004 + 0.02 * i as f64))
+            .collect();
+        points.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
+        let mut unit = chain_edges(&points[..5], false);
+        unit.push(IslandEdge::gap(4, 5));
+        unit.extend(
+            chain_edges(&points[5..], false)
+                .into_iter()
+                .map(|e| IslandEdge {
+                    a: e.a + 5,
+                    b: e.b + 5,
+                    ..e
+                }),
+        );
+        let mut velocity = vec![DVec2::ZERO; 10];
+        velocity[..5].fill(DVec2::new(0.3, -1.0));
+        velocity[1] = DVec2::new(0.3, -2.0);
+        velocity[7] = DVec2::new(-0.2, 0.5); // B rises to meet A
+        let contact = ContactRow::point_edge(pair(0, 6, 7, 0.5), DVec2::Y, &velocity);
+        let inverse_mass: Vec<f64> = (0..10).map(|i| 1.0 / (1.0 + 0.1 * i as f64)).collect();
+        let case = Case {
+            edges: &unit,
+            closed: false,
+            position: &points,
+            inverse_mass: &inverse_mass,
+            contacts: &[contact],
+            dt: 0.01,
+        };
+        let mut v = velocity.clone();
+        let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
+        assert!(outcome.converged, "{outcome:?}");
+        assert_eq!(outcome.locked, 0, "the gap is not counted as a locked edge");
+        // The gap's "edge" is no constraint: only the real edges are measured.
+        let real: Vec<IslandEdge> = unit
+            .iter()
+            .copied()
+            .filter(|e| e.edge != IslandEdge::GAP)
+            .collect();
+        let measured = Case {
+            edges: &real,
+            ..case
+        };
+        assert!(measured.max_relative_error(&v) < 1e-12);
+        let polish = POLISH_RESIDUAL * 0.02 / case.dt;
+        assert!(contact.normal_velocity(&v) >= contact.target - polish);
+        let momentum =
+            |v: &[DVec2]| -> DVec2 { v.iter().zip(&inverse_mass).map(|(v, w)| *v / *w).sum() };
+        assert!((momentum(&v) - momentum(&velocity)).length() < 1e-12);
+        // Both strands moved: the contact pushed A up and B down.
+        assert!(v[0].y > velocity[0].y && v[6].y + v[7].y < velocity[6].y + velocity[7].y);
     }
 }

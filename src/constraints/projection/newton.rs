@@ -59,22 +59,64 @@ pub(super) fn project_walk<W: Walk>(
         scratch.predicted_edge[k] = scratch.start_direction[k] + dt * (velocity[b] - velocity[a]);
         let (ja, jb) = walk.ends(k, particles);
         let w = scratch.inverse_mass[ja] + scratch.inverse_mass[jb];
-        scratch.locked[k] = scratch.predicted_edge[k].length_squared() * w <= 0.0;
+        scratch.locked[k] =
+            e.edge == IslandEdge::GAP || scratch.predicted_edge[k].length_squared() * w <= 0.0;
     }
     if !contacts.is_empty() {
         scratch.reserve_contacts(m, walk.max_degree(), velocity.len());
     }
-    localize_contacts(contacts, particles, &particle, velocity, dt, scratch);
+    let locked = (scratch.locked[..m].iter().zip(edges))
+        .filter(|&(&l, e)| l && e.edge != IslandEdge::GAP)
+        .count() as u32;
+    // Contacts solved exactly first; if that asks for an absurd correction, once more
+    // with the iterative contact solve, whose truncation damps nearly dependent rows.
+    let mut outcome = ProjectionOutcome::default();
+    for exact in [true, false] {
+        if !exact && (contacts.is_empty() || !outcome.rejected) {
+            break;
+        }
+        scratch.correction[..particles].fill(DVec2::ZERO);
+        scratch.exact_contacts = exact;
+        localize_contacts(contacts, particles, &particle, velocity, dt, scratch);
+        outcome = iterate(edges, walk, shortest, settings, scratch);
+        outcome.locked = locked;
+        let correction = &scratch.correction[..particles];
+        let limit = settings.max_correction * shortest;
+        outcome.rejected = settings.max_correction.is_finite()
+            && correction
+                .iter()
+                .any(|c| c.length().is_nan() || c.length() > limit);
+    }
+    if outcome.rejected {
+        outcome.converged = false;
+        return outcome;
+    }
+    let correction = &scratch.correction[..particles];
+    for (j, c) in correction.iter().enumerate() {
+        if scratch.inverse_mass[j] > 0.0 {
+            velocity[particle(j)] += *c / dt;
+        }
+    }
+    outcome
+}
+
+/// The Newton iterations from the correction in `scratch` (zero) with its localized
+/// contact rows, until the edges meet the tolerance and the contacts are settled.
+fn iterate<W: Walk>(
+    edges: &[IslandEdge],
+    walk: W,
+    shortest: f64,
+    settings: &ProjectionSettings,
+    scratch: &mut IslandScratch,
+) -> ProjectionOutcome {
+    let m = edges.len();
+    let particles = walk.particles(edges);
     let direction = if scratch.rows.is_empty() && !walk.symmetric_only() {
         settings.direction
     } else {
         ConstraintDirection::EndOfStep
     };
-
-    let mut outcome = ProjectionOutcome {
-        locked: scratch.locked[..m].iter().filter(|&&l| l).count() as u32,
-        ..Default::default()
-    };
+    let mut outcome = ProjectionOutcome::default();
     let contact_tolerance = settings.contact_tolerance;
     let mut previous_violation = f64::INFINITY;
     loop {
@@ -112,39 +154,36 @@ pub(super) fn project_walk<W: Walk>(
             break;
         }
         outcome.iterations += 1;
-        if newton_step(m, particles, walk, direction, contact_tolerance, s).is_err() {
+        // Pivoting that has not settled in half the iterations is on a problem whose
+        // linearization keeps moving: the iterative solve's damping finishes it.
+        if s.exact_contacts && 2 * outcome.iterations > settings.max_iterations {
+            s.exact_contacts = false;
+        }
+        let trust = if s.exact_contacts {
+            0.5 * shortest
+        } else {
+            f64::INFINITY
+        };
+        if newton_step(m, particles, walk, direction, contact_tolerance, trust, s).is_err() {
             outcome.singular = true;
             break;
         }
     }
 
-    let correction = &scratch.correction[..particles];
-    if settings.max_correction.is_finite() {
-        let limit = settings.max_correction * shortest;
-        if correction
-            .iter()
-            .any(|c| c.length().is_nan() || c.length() > limit)
-        {
-            outcome.rejected = true;
-            outcome.converged = false;
-            return outcome;
-        }
-    }
-    for (j, c) in correction.iter().enumerate() {
-        if scratch.inverse_mass[j] > 0.0 {
-            velocity[particle(j)] += *c / dt;
-        }
-    }
     outcome
 }
 
-/// One Newton step on the edges (and contact rows) from the current corrections.
+/// One Newton step on the edges (and contact rows) from the current corrections. With
+/// contact rows the step moves no particle by more than `trust`: the linearized edges
+/// allow any motion along themselves, and contacts met exactly on that linearization
+/// can ask for a lever's swing the edges cannot follow; a shorter step re-linearizes.
 fn newton_step<W: Walk>(
     m: usize,
     particles: usize,
     walk: W,
     direction_kind: ConstraintDirection,
     contact_tolerance: f64,
+    trust: f64,
     s: &mut IslandScratch,
 ) -> Result<(), SingularPivot> {
     let rows = s.rows.len();
@@ -155,6 +194,7 @@ fn newton_step<W: Walk>(
 
     if rows > 0 {
         eliminate_contacts(m, walk, contact_tolerance, s);
+        s.step_start[..particles].copy_from_slice(&s.correction[..particles]);
     }
 
     let direction: &[DVec2] = match direction_kind {
@@ -171,6 +211,20 @@ fn newton_step<W: Walk>(
         let (row, mu) = (s.rows[c], s.impulse[c]);
         for &(j, coefficient) in &row.entries[..row.count] {
             s.correction[j as usize] += s.inverse_mass[j as usize] * coefficient * mu * row.normal;
+        }
+    }
+    if rows > 0 {
+        let (start, correction) = (&s.step_start[..particles], &mut s.correction[..particles]);
+        let longest = start
+            .iter()
+            .zip(correction.iter())
+            .map(|(a, b)| (*b - *a).length())
+            .fold(0.0f64, f64::max);
+        if longest > trust {
+            let shrink = trust / longest;
+            for (a, b) in start.iter().zip(correction.iter_mut()) {
+                *b = *a + shrink * (*b - *a);
+            }
         }
     }
     Ok(())

@@ -3,13 +3,14 @@
 
 use bevy::math::DVec2;
 
+use crate::constraints::complementarity::ActiveSetScratch;
 use crate::constraints::cyclic::CyclicFactor;
 use crate::constraints::sparse::SparseFactor;
 use crate::constraints::tridiagonal::TridiagonalFactor;
 
 /// Contact rows one projection takes at most; further ones are left to the collision
 /// stage's verification.
-pub const MAX_CONTACT_ROWS: usize = 64;
+pub const MAX_CONTACT_ROWS: usize = 256;
 
 /// A contact row in island-local terms.
 #[derive(Clone, Copy, Debug, Default)]
@@ -26,6 +27,7 @@ pub(super) struct LocalRow {
 #[derive(Clone, Debug, Default)]
 pub struct IslandScratch {
     pub(super) correction: Vec<DVec2>,
+    pub(super) step_start: Vec<DVec2>,
     pub(super) inverse_mass: Vec<f64>,
     pub(super) locked: Vec<bool>,
     pub(super) predicted_edge: Vec<DVec2>,
@@ -48,6 +50,9 @@ pub struct IslandScratch {
     pub(super) impulse: Vec<f64>,
     pub(super) contact_residual: Vec<f64>,
     pub(super) row_particles: Vec<(u32, u32, f64)>,
+    pub(super) pivoting: ActiveSetScratch,
+    /// Whether the contact problem is solved by pivoting (else iterated).
+    pub(super) exact_contacts: bool,
 }
 
 impl IslandScratch {
@@ -55,6 +60,7 @@ impl IslandScratch {
     /// (allocates only when growing).
     pub fn reserve(&mut self, edges: usize, particles: usize) {
         grow(&mut self.correction, particles, DVec2::ZERO);
+        grow(&mut self.step_start, particles, DVec2::ZERO);
         grow(&mut self.inverse_mass, particles, 0.0);
         grow(&mut self.locked, edges, false);
         grow(&mut self.predicted_edge, edges, DVec2::ZERO);
@@ -84,6 +90,7 @@ impl IslandScratch {
         grow(&mut self.offset, rows, 0.0);
         grow(&mut self.impulse, rows, 0.0);
         grow(&mut self.contact_residual, rows, 0.0);
+        self.pivoting.reserve(rows);
         self.row_particles
             .reserve((3 * rows).saturating_sub(self.row_particles.len()));
         // Up to `degree` edges at each of a row's three particles.
