@@ -51,16 +51,13 @@ pub struct ContactRows {
     pub rows: Vec<ContactRow>,
     /// Each island projected, and whether it met its edges.
     outcomes: Vec<(u32, bool)>,
-    /// The edges that cannot move (static: both ends pinned), for the topology version
-    /// in `obstacles_version`.
-    obstacles: Vec<u32>,
-    obstacles_version: Option<u64>,
 }
 
 /// The Speculate sub-stage: the points the projected motion would bring within `keep`
-/// of the thickness of an obstacle (an edge that cannot move: walls, pinned edges)
-/// become rows, and their islands are projected again with them, before any impulse. An island whose projection with rows fails is projected alone
-/// again, so that the stage always leaves every edge met.
+/// of the thickness of an edge become rows, and their islands are projected again with
+/// them, before any impulse: against obstacles (walls, pinned edges) and between paths,
+/// which are projected together as one unit. An island whose projection with rows
+/// fails is projected alone again, so that the stage always leaves every edge met.
 #[allow(clippy::too_many_arguments)]
 pub fn speculate(
     collisions: Res<CollisionConfig>,
@@ -92,25 +89,18 @@ pub fn speculate(
         step.dt,
         &mut scratch.impulses,
     );
-    // Only against what cannot move (walls, pinned edges): a row between two free
-    // islands, solved island by island, would push only the first one solved. Those
-    // pairs are left to the impulses, which conserve momentum.
-    if buffers.obstacles_version != Some(topology.version) {
-        buffers.obstacles.clear();
-        let edges = topology.edges.iter().enumerate();
-        buffers
-            .obstacles
-            .extend(edges.filter(|(_, e)| e.is_static).map(|(k, _)| k as u32));
-        buffers.obstacles_version = Some(topology.version);
-    }
-    if buffers.obstacles.is_empty() {
-        return;
-    }
-    collider.find_pairs_against(&buffers.obstacles);
+    collider.find_pairs();
     let (position, velocity, dt) = (collider.position, &*collider.velocity, collider.dt);
     buffers.rows.clear();
+    let groups = collider.groups;
     for &(p, k) in &collider.scratch.pairs {
         let e = &collider.edges[k as usize];
+        // A row between two free islands is met by both at once only when both are
+        // paths (one unit); with a loop, tree or graph the island sweep would push the
+        // first one solved, so those pairs stay with the momentum-conserving impulses.
+        if !islands.one_unit([p, e.a, e.b].map(|i| groups[i as usize])) {
+            continue;
+        }
         let (q, r) = (position[e.a as usize], position[e.b as usize]);
         let x = position[p as usize];
         let (alpha, gap) = closest_on_segment(x, q, r);

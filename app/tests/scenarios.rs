@@ -63,6 +63,40 @@ fn long_strand_stays_exact_through_contact_at_larger_steps() {
 }
 
 #[test]
+fn the_factories_stay_exact_and_uncrossed_at_game_sized_steps() {
+    // Five seconds at 1/600 and 1/300: the strands pile up on the floor and on each
+    // other, with the contact projection's pivoting, its fallback and, rarely, the
+    // rigid fail-safe all taking part.
+    for (scenario, steps_per_second) in [
+        ("spaghetti_factory", 600.0),
+        ("spaghetti_factory", 300.0),
+        ("meatball_factory", 600.0),
+    ] {
+        let report = run_ok(&RunOptions {
+            dt: Some(1.0 / steps_per_second),
+            substeps: Some(3),
+            ..options(scenario, 5.0)
+        });
+        let name = format!("{scenario} at 1/{steps_per_second}");
+        assert_eq!(
+            report.edge_crossings,
+            Some(0),
+            "{name}: {:?}",
+            report.first_crossing
+        );
+        assert!(
+            report.max_rel_length_error < 1e-9,
+            "{name}: {:e}",
+            report.max_rel_length_error
+        );
+        assert!(
+            report.collisions > 0 && report.contact_projection_solves > 0,
+            "{name}"
+        );
+    }
+}
+
+#[test]
 fn branches_solves_its_trees_and_graphs_exactly() {
     // One second: the ladder is thrown into the trees and falls back on the truss.
     let report = run_ok(&options("branches", 1.0));

@@ -61,9 +61,6 @@ const MAX_CELLS_PER_EDGE: i64 = 4096;
 #[derive(Clone, Debug, Default)]
 pub struct BroadPhase {
     edge_boxes: Vec<Aabb>,
-    /// The edge of each box when the grid holds a subset of the edges; empty: box k
-    /// is edge k.
-    ids: Vec<u32>,
     cell_size: f64,
     mask: usize,
     bucket_start: Vec<u32>,
@@ -104,34 +101,7 @@ impl BroadPhase {
         displacement: Option<&[DVec2]>,
         margin: f64,
     ) {
-        self.ids.clear();
         self.build_boxes(edges.iter(), position, displacement, margin);
-    }
-
-    /// Build the grid over the swept boxes of the edges listed in `subset` only (for
-    /// example the obstacles); pairs still name edges by their index in `edges`.
-    pub fn build_subset(
-        &mut self,
-        edges: &[Edge],
-        subset: &[u32],
-        position: &[DVec2],
-        displacement: Option<&[DVec2]>,
-        margin: f64,
-    ) {
-        self.ids.clear();
-        self.ids.extend_from_slice(subset);
-        let boxes = subset.iter().map(|&k| &edges[k as usize]);
-        self.build_boxes(boxes, position, displacement, margin);
-    }
-
-    /// The edge of box `k`.
-    #[inline]
-    fn id(&self, k: u32) -> u32 {
-        if self.ids.is_empty() {
-            k
-        } else {
-            self.ids[k as usize]
-        }
     }
 
     fn build_boxes<'e>(
@@ -259,20 +229,16 @@ impl BroadPhase {
             let point = i as u32;
             match method {
                 BroadPhaseMethod::Grid => {
-                    let ids = std::mem::take(&mut self.ids);
-                    let id = |k: u32| if ids.is_empty() { k } else { ids[k as usize] };
                     self.visit(&query, point + 1, |k| {
-                        if keep(point, id(k)) {
-                            pairs.push((point, id(k)));
+                        if keep(point, k) {
+                            pairs.push((point, k));
                         }
                     });
-                    self.ids = ids;
                 }
                 BroadPhaseMethod::BruteForce => {
                     for k in 0..self.edge_boxes.len() as u32 {
-                        let edge = self.id(k);
-                        if self.edge_boxes[k as usize].overlaps(&query) && keep(point, edge) {
-                            pairs.push((point, edge));
+                        if self.edge_boxes[k as usize].overlaps(&query) && keep(point, k) {
+                            pairs.push((point, k));
                         }
                     }
                 }
@@ -281,14 +247,13 @@ impl BroadPhase {
     }
 
     /// Append every pair of edges (j < k) whose boxes overlap and for which `keep`
-    /// holds. Call [`BroadPhase::build`] (not a subset) first.
+    /// holds. Call [`BroadPhase::build`] first.
     pub fn edge_edge_pairs(
         &mut self,
         method: BroadPhaseMethod,
         keep: impl Fn(u32, u32) -> bool,
         pairs: &mut Vec<(u32, u32)>,
     ) {
-        debug_assert!(self.ids.is_empty(), "edge pairs need a grid of every edge");
         self.reset_seen();
         for j in 0..self.edge_boxes.len() as u32 {
             let query = self.edge_boxes[j as usize];

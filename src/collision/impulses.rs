@@ -185,33 +185,6 @@ impl Collider<'_> {
         );
     }
 
-    /// Candidate pairs of the free points against the edges in `subset` only (the
-    /// obstacles), for the current velocities.
-    pub fn find_pairs_against(&mut self, subset: &[u32]) {
-        let scratch = &mut *self.scratch;
-        displacements(self.velocity, self.dt, &mut scratch.displacement);
-        scratch.broad.build_subset(
-            self.edges,
-            subset,
-            self.position,
-            Some(&scratch.displacement),
-            self.settings.thickness,
-        );
-        scratch.pairs.clear();
-        let (edges, w) = (self.edges, self.inverse_mass);
-        let keep = |p: u32, k: u32| {
-            let e = &edges[k as usize];
-            e.a != p && e.b != p && w[p as usize] > 0.0
-        };
-        scratch.broad.point_edge_pairs(
-            self.settings.broad_phase,
-            self.position,
-            &scratch.displacement,
-            keep,
-            &mut scratch.pairs,
-        );
-    }
-
     fn pair(&self, p: u32, k: u32, alpha: f64) -> PointEdgePair {
         let e = &self.edges[k as usize];
         PointEdgePair {
