@@ -233,7 +233,11 @@ pub struct ContactConfig {
     /// pass finds no new collision, so at small steps one or two run whatever the cap.
     /// 0 leaves edges next to contacts as the impulses leave them.
     pub passes: u32,
-    /// Gauss–Seidel sweeps over the islands in contact per re-projection, at most.
+    /// Gauss–Seidel sweeps over the contact units per re-projection, at most. Paths in
+    /// contact are one unit already, and the contact loop's passes sweep again with
+    /// the impulses in between: at dt = 1/600 two sweeps made a dense pile 2.5 times
+    /// faster than eight (and the factories 1.1 to 1.5 times), leaving a few more
+    /// steps to the exact fail-safe; at 1/3000 the cap is never reached.
     pub sweeps: u32,
     /// A re-projection that would move any particle by more than this many of its
     /// island's shortest rest lengths in one step is refused: room for a strand that
@@ -260,7 +264,7 @@ impl Default for ContactConfig {
     fn default() -> Self {
         Self {
             passes: 16,
-            sweeps: 8,
+            sweeps: 2,
             max_correction: 2.0,
             tolerance: 1e-3,
             keep: 0.5,
