@@ -44,6 +44,20 @@ impl Plugin for ContactLoopPlugin {
     }
 }
 
+/// The projection's settings with contact rows: the constraint settings, with the
+/// contact loop's correction guard and tolerance.
+fn contact_projection(
+    contact: &ContactConfig,
+    collisions: &CollisionConfig,
+    constraints: &ConstraintConfig,
+) -> ProjectionSettings {
+    ProjectionSettings {
+        max_correction: contact.max_correction,
+        contact_tolerance: contact.tolerance * collisions.thickness,
+        ..constraints.projection()
+    }
+}
+
 /// The contact rows of the latest re-projection, reused every step.
 #[derive(Resource, Default, Debug)]
 pub struct ContactRows {
@@ -74,11 +88,7 @@ pub fn speculate(
     if !(collisions.enabled && constraints.solver.projects_contacts() && contact.speculative) {
         return;
     }
-    let settings = ProjectionSettings {
-        max_correction: contact.max_correction,
-        contact_tolerance: contact.tolerance * collisions.thickness,
-        ..constraints.projection()
-    };
+    let settings = contact_projection(&contact, &collisions, &constraints);
     let impulse_settings = collisions.impulse_settings();
     let keep = contact.keep * collisions.thickness;
     let buffers = &mut *buffers;
@@ -167,11 +177,7 @@ pub fn contact_loop(
     if !(collisions.enabled && constraints.solver.projects_contacts() && contact.passes > 0) {
         return;
     }
-    let settings = ProjectionSettings {
-        max_correction: contact.max_correction,
-        contact_tolerance: contact.tolerance * collisions.thickness,
-        ..constraints.projection()
-    };
+    let settings = contact_projection(&contact, &collisions, &constraints);
     let impulse_settings = collisions.impulse_settings();
     let scratch = &mut *scratch;
     let mut changed = scratch.outcome.impulses > 0;

@@ -324,28 +324,7 @@ fn a_blocked_inlet_stops_the_factory_instead_of_pushing_through() {
             particles_per_strand: 13,
         )),
     )"#;
-    let file = scratch("blocked_inlet.ron");
-    std::fs::write(&file, scene).unwrap();
-    let report = run_ok(&RunOptions {
-        scene_file: Some(file),
-        ..options("blocked_inlet", 1.0)
-    });
-    assert_eq!(
-        report.edge_crossings,
-        Some(0),
-        "{:?}",
-        report.first_crossing
-    );
-    assert!(
-        report.notes.iter().any(|n| n.contains("inlet was blocked")),
-        "{:?}",
-        report.notes
-    );
-    assert!(
-        report.max_rel_length_error < 1e-9,
-        "{:e}",
-        report.max_rel_length_error
-    );
+    the_inlet_waits_and_nothing_crosses("blocked_inlet", scene, 1.0);
 }
 
 #[test]
@@ -369,26 +348,32 @@ fn no_edge_is_born_across_a_strand_that_moves_with_the_extrusion() {
             particles_per_strand: 13,
         )),
     )"#;
-    let file = scratch("edge_born_across.ron");
+    the_inlet_waits_and_nothing_crosses("edge_born_across", scene, 0.3);
+}
+
+/// Run the factory scene `scene` for `seconds`: its inlet must have stood still at
+/// some point, with no crossing and exact edges.
+fn the_inlet_waits_and_nothing_crosses(name: &str, scene: &str, seconds: f64) {
+    let file = scratch(&format!("{name}.ron"));
     std::fs::write(&file, scene).unwrap();
     let report = run_ok(&RunOptions {
         scene_file: Some(file),
-        ..options("edge_born_across", 0.3)
+        ..options(name, seconds)
     });
     assert_eq!(
         report.edge_crossings,
         Some(0),
-        "{:?}",
+        "{name}: {:?}",
         report.first_crossing
     );
     assert!(
         report.notes.iter().any(|n| n.contains("inlet was blocked")),
-        "{:?}",
+        "{name}: {:?}",
         report.notes
     );
     assert!(
         report.max_rel_length_error < 1e-9,
-        "{:e}",
+        "{name}: {:e}",
         report.max_rel_length_error
     );
 }
