@@ -7,19 +7,21 @@
 
 /// Solve the complementarity problem `S μ + q ≥ 0, μ ≥ 0, μ·(S μ + q) = 0` for a small
 /// symmetric positive semidefinite `S` (row-major) by projected Gauss–Seidel, until no
-/// sweep moves any row's residual by more than `tolerance`. The residual `S μ + q` is
-/// kept up to date as μ changes, so rows that stay inactive cost nothing.
+/// sweep moves any row's residual by more than `tolerance` or `max_sweeps` are done.
+/// The residual `S μ + q` is kept up to date as μ changes, so rows that stay inactive
+/// cost nothing. Returns the sweeps taken.
 pub fn projected_gauss_seidel(
     schur: &[f64],
     offset: &[f64],
     tolerance: f64,
+    max_sweeps: u32,
     mu: &mut [f64],
     residual: &mut [f64],
-) {
+) -> u32 {
     let n = offset.len();
     mu.fill(0.0);
     residual.copy_from_slice(offset);
-    for _sweep in 0..200 {
+    for sweep in 1..=max_sweeps {
         let mut change = 0.0f64;
         for c in 0..n {
             let diagonal = schur[c * n + c];
@@ -39,9 +41,10 @@ pub fn projected_gauss_seidel(
             change = change.max(delta.abs() * diagonal);
         }
         if change <= tolerance {
-            break;
+            return sweep;
         }
     }
+    max_sweeps
 }
 
 /// Reusable buffers of [`active_set`], for problems of up to `n` rows.
@@ -459,7 +462,7 @@ mod tests {
             let (mut a, mut wa) = (vec![0.0; n], vec![0.0; n]);
             let (mut b, mut wb) = (vec![0.0; n], vec![0.0; n]);
             active_set(&s, &q, 1e-13, &mut a, &mut wa, &mut scratch).unwrap();
-            projected_gauss_seidel(&s, &q, 1e-13, &mut b, &mut wb);
+            projected_gauss_seidel(&s, &q, 1e-13, 200, &mut b, &mut wb);
             for (x, y) in a.iter().zip(&b) {
                 assert!((x - y).abs() <= 1e-9, "{x} {y}");
             }
