@@ -143,6 +143,7 @@ pub fn speculate(
         dt,
         &settings,
         contact.sweeps,
+        false,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
     );
@@ -271,6 +272,7 @@ fn reproject(
         dt,
         settings,
         contact.sweeps,
+        true,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
     );
