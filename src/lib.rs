@@ -20,9 +20,9 @@
 //!     .pin_first()
 //!     .spawn_in(app.world_mut())
 //!     .unwrap();
-//! // One tick: 30 steps of 1/3000 s.
+//! // One tick: 6 steps of 1/600 s.
 //! app.world_mut().run_schedule(StrandsTick);
-//! assert_eq!(app.world().resource::<SimulationClock>().steps, 30);
+//! assert_eq!(app.world().resource::<SimulationClock>().steps, 6);
 //! # let _ = rope;
 //! ```
 //!

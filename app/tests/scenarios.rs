@@ -37,7 +37,7 @@ fn long_strand_runs_with_its_counts() {
     );
     assert_eq!(report.edge_crossings, Some(0));
     assert!(report.max_rel_length_error < 1e-12);
-    assert_eq!(report.steps, 900);
+    assert_eq!(report.steps, 180); // 0.3 s at the default 1/600
 }
 
 #[test]
