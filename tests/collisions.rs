@@ -44,6 +44,9 @@ fn a_fast_particle_does_not_tunnel_through_a_thin_pinned_edge() {
 #[test]
 fn strands_thrown_at_each_other_never_cross() {
     let mut app = checked_app();
+    // At 1/600 a contact between two units solved one-sided once lost a third of the
+    // momentum here (speculative rows must stay inside a unit).
+    set_step(&mut app, 1.0 / 600.0, 6);
     app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
     // Two strands crossing each other's paths at 20 units/s each, one tilted.
     let a = StrandBuilder::line(DVec2::new(0.1, 0.4), DVec2::Y, 20, 0.01)

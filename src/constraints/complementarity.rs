@@ -462,11 +462,26 @@ mod tests {
             let (mut a, mut wa) = (vec![0.0; n], vec![0.0; n]);
             let (mut b, mut wb) = (vec![0.0; n], vec![0.0; n]);
             active_set(&s, &q, 1e-13, &mut a, &mut wa, &mut scratch).unwrap();
-            projected_gauss_seidel(&s, &q, 1e-13, 200, &mut b, &mut wb);
+            let sweeps = projected_gauss_seidel(&s, &q, 1e-13, 200, &mut b, &mut wb);
+            assert!(
+                sweeps < 200,
+                "diagonally dominant: converges before the cap"
+            );
             for (x, y) in a.iter().zip(&b) {
                 assert!((x - y).abs() <= 1e-9, "{x} {y}");
             }
         }
+    }
+
+    #[test]
+    fn gauss_seidel_stops_at_its_sweep_cap_on_conflicting_rows() {
+        // Two copies of one row asking for opposite signs of the same motion: no
+        // solution, and the impulses grow every sweep.
+        let s = [1.0, -1.0, -1.0, 1.0];
+        let q = [-1.0, -1.0];
+        let (mut mu, mut w) = ([0.0; 2], [0.0; 2]);
+        assert_eq!(projected_gauss_seidel(&s, &q, 1e-12, 7, &mut mu, &mut w), 7);
+        assert!(mu.iter().all(|m| m.is_finite() && *m > 0.0), "{mu:?}");
     }
 
     #[test]
