@@ -5,13 +5,50 @@
 //! solver); [`projected_gauss_seidel`] iterates to a tolerance, the fallback when
 //! pivoting stalls on a degenerate problem.
 
+/// The matrix `S` of a complementarity problem, read a column at a time: the solvers
+/// touch only the columns of rows that take an impulse, so a caller may form those
+/// alone (most contact rows never do).
+pub trait Schur {
+    /// Column `c` of `S` (equal to its row: `S` is symmetric).
+    fn column(&mut self, c: usize) -> &[f64];
+    /// A stiffness of row `c` that ranks rows when pricing, `√S_cc` or a bound of the
+    /// same scale; zero for a row that no impulse can move.
+    fn scale(&self, c: usize) -> f64;
+}
+
+/// A fully formed symmetric `S`, row-major.
+#[derive(Clone, Copy, Debug)]
+pub struct DenseSchur<'a> {
+    matrix: &'a [f64],
+    n: usize,
+}
+
+impl<'a> DenseSchur<'a> {
+    /// `matrix` is `n × n`, row-major.
+    pub fn new(matrix: &'a [f64], n: usize) -> Self {
+        assert_eq!(matrix.len(), n * n, "an n × n matrix");
+        Self { matrix, n }
+    }
+}
+
+impl Schur for DenseSchur<'_> {
+    fn column(&mut self, c: usize) -> &[f64] {
+        &self.matrix[c * self.n..(c + 1) * self.n]
+    }
+
+    fn scale(&self, c: usize) -> f64 {
+        let diagonal = self.matrix[c * self.n + c];
+        if diagonal > 0.0 { diagonal.sqrt() } else { 0.0 }
+    }
+}
+
 /// Solve the complementarity problem `S μ + q ≥ 0, μ ≥ 0, μ·(S μ + q) = 0` for a small
-/// symmetric positive semidefinite `S` (row-major) by projected Gauss–Seidel, until no
+/// symmetric positive semidefinite `S` by projected Gauss–Seidel, until no
 /// sweep moves any row's residual by more than `tolerance` or `max_sweeps` are done.
 /// The residual `S μ + q` is kept up to date as μ changes, so rows that stay inactive
 /// cost nothing. Returns the sweeps taken.
 pub fn projected_gauss_seidel(
-    schur: &[f64],
+    schur: &mut impl Schur,
     offset: &[f64],
     tolerance: f64,
     max_sweeps: u32,
@@ -24,7 +61,13 @@ pub fn projected_gauss_seidel(
     for sweep in 1..=max_sweeps {
         let mut change = 0.0f64;
         for c in 0..n {
-            let diagonal = schur[c * n + c];
+            // A row without impulse and with a residual to spare stays so: its column
+            // is not needed.
+            if mu[c] == 0.0 && residual[c] >= 0.0 {
+                continue;
+            }
+            let column = schur.column(c);
+            let diagonal = column[c];
             if diagonal <= 0.0 {
                 continue;
             }
@@ -34,8 +77,7 @@ pub fn projected_gauss_seidel(
                 continue;
             }
             mu[c] = updated;
-            // S is symmetric: column c is row c.
-            for (r, s) in residual.iter_mut().zip(&schur[c * n..(c + 1) * n]) {
+            for (r, s) in residual.iter_mut().zip(column) {
                 *r += s * delta;
             }
             change = change.max(delta.abs() * diagonal);
@@ -59,6 +101,9 @@ pub struct ActiveSetScratch {
     /// The unconstrained minimiser on the active set, then a work vector.
     target: Vec<f64>,
     work: Vec<f64>,
+    /// `√S_cc` of each row (zero for a row with no stiffness): pricing reads it
+    /// contiguously instead of striding down the diagonal at every pivot.
+    stiffness: Vec<f64>,
 }
 
 impl ActiveSetScratch {
@@ -69,6 +114,7 @@ impl ActiveSetScratch {
             self.factor.resize(n * n, 0.0);
             self.target.resize(n, 0.0);
             self.work.resize(n, 0.0);
+            self.stiffness.resize(n, 0.0);
             self.active.reserve(n);
         }
     }
@@ -92,7 +138,7 @@ const DEPENDENT: f64 = 1e-9;
 pub struct Stalled;
 
 /// Solve the complementarity problem `S μ + q ≥ 0, μ ≥ 0, μ·(S μ + q) = 0` for a small
-/// symmetric positive semidefinite `S` (row-major) exactly, by a primal active-set
+/// symmetric positive semidefinite `S` exactly, by a primal active-set
 /// method: the problem is the minimum of `½ μᵀSμ + qᵀμ` over `μ ≥ 0`, and Lawson and
 /// Hanson's pivoting for non-negative least squares finds it in about as many pivots
 /// as rows end active. A row joins while its residual is below `−tolerance`; the
@@ -107,7 +153,7 @@ pub struct Stalled;
 /// Returns the pivots taken, or [`Stalled`] when the pivoting cycles on a degenerate
 /// problem (after `4n + 8` pivots); `mu` and `residual` then hold the best point so far.
 pub fn active_set(
-    schur: &[f64],
+    schur: &mut impl Schur,
     offset: &[f64],
     tolerance: f64,
     mu: &mut [f64],
@@ -122,9 +168,13 @@ pub fn active_set(
         factor,
         target,
         work,
+        stiffness,
     } = scratch;
     active.clear();
     status[..n].fill(RowStatus::Inactive);
+    for (c, root) in stiffness[..n].iter_mut().enumerate() {
+        *root = schur.scale(c);
+    }
     mu.fill(0.0);
     residual.copy_from_slice(offset);
     let mut pivots = 0u32;
@@ -132,16 +182,18 @@ pub fn active_set(
     loop {
         // Price: the row whose residual most needs an impulse, per unit of its own
         // stiffness, so that scaling a row does not change which joins.
-        let entering = (0..n)
-            .filter(|&c| {
-                status[c] == RowStatus::Inactive
-                    && schur[c * n + c] > 0.0
-                    && residual[c] < -tolerance
-            })
-            .min_by(|&a, &b| {
-                let scaled = |c: usize| residual[c] / schur[c * n + c].sqrt();
-                scaled(a).total_cmp(&scaled(b))
-            });
+        let mut entering = None;
+        let mut most = 0.0f64;
+        for c in 0..n {
+            if status[c] == RowStatus::Inactive && stiffness[c] > 0.0 && residual[c] < -tolerance {
+                let scaled = residual[c] / stiffness[c];
+                // The first of equal rows wins, as `min_by` would pick.
+                if entering.is_none() || scaled.total_cmp(&most).is_lt() {
+                    entering = Some(c);
+                    most = scaled;
+                }
+            }
+        }
         let Some(entering) = entering else {
             return Ok(pivots);
         };
@@ -151,8 +203,9 @@ pub fn active_set(
             // row's negative residual, so go until an active impulse reaches zero and
             // exchange the two rows. With no such impulse the rows conflict.
             let k = active.len();
+            let column = schur.column(entering);
             for (t, &r) in target[..k].iter_mut().zip(active.iter()) {
-                *t = schur[r * n + entering];
+                *t = column[r];
             }
             cholesky_solve(factor, n, k, &mut target[..k]);
             let ratio = |i: usize| mu[active[i]] / target[i];
@@ -170,7 +223,7 @@ pub fn active_set(
             let leaving = active.remove(b);
             mu[leaving] = 0.0;
             status[leaving] = RowStatus::Inactive;
-            refactor(schur, n, active, factor, work);
+            refactor(schur, n, active, b, factor, work);
             if !append_row(schur, n, entering, active, factor, work) {
                 status[entering] = RowStatus::Dependent;
                 continue;
@@ -205,6 +258,11 @@ pub fn active_set(
                 break;
             }
             let before = active.len();
+            // Rows of the factor before the first that leaves stay as they are.
+            let mut unchanged = active
+                .iter()
+                .position(|&c| mu[c] <= 0.0 || mu[c].is_nan())
+                .unwrap_or(before);
             active.retain(|&c| {
                 let keep = mu[c] > 0.0;
                 if !keep {
@@ -228,14 +286,15 @@ pub fn active_set(
                     let c = active.remove(i);
                     mu[c] = 0.0;
                     status[c] = RowStatus::Inactive;
+                    unchanged = i;
                 }
             }
-            refactor(schur, n, active, factor, work);
+            refactor(schur, n, active, unchanged, factor, work);
         }
         // w = S μ + q over the rows with an impulse.
         residual.copy_from_slice(offset);
         for &c in active.iter() {
-            let column = &schur[c * n..(c + 1) * n];
+            let column = schur.column(c);
             for (r, s) in residual.iter_mut().zip(column) {
                 *r += s * mu[c];
             }
@@ -246,7 +305,7 @@ pub fn active_set(
 /// Grow the Cholesky factor of `S` on `active` by the row `c`, unless `c` is a
 /// combination of the active rows (then `false`, and nothing changes).
 fn append_row(
-    schur: &[f64],
+    schur: &mut impl Schur,
     n: usize,
     c: usize,
     active: &mut Vec<usize>,
@@ -254,25 +313,34 @@ fn append_row(
     work: &mut [f64],
 ) -> bool {
     active.push(c);
-    let independent = factor_row(schur, n, active, active.len() - 1, factor, work);
+    let independent = factor_row(schur.column(c), n, active, active.len() - 1, factor, work);
     if !independent {
         active.pop();
     }
     independent
 }
 
-/// Rebuild the factor on `active` from scratch (after a row left: a subset of
-/// independent rows is independent).
-fn refactor(schur: &[f64], n: usize, active: &[usize], factor: &mut [f64], work: &mut [f64]) {
-    for i in 0..active.len() {
-        factor_row(schur, n, active, i, factor, work);
+/// Rebuild the factor on `active` from its row `from` on, after rows left there (a
+/// subset of independent rows is independent; rows before `from` depend only on the
+/// rows before them, which did not change).
+fn refactor(
+    schur: &mut impl Schur,
+    n: usize,
+    active: &[usize],
+    from: usize,
+    factor: &mut [f64],
+    work: &mut [f64],
+) {
+    for i in from..active.len() {
+        factor_row(schur.column(active[i]), n, active, i, factor, work);
     }
 }
 
-/// Row `i` of the Cholesky factor of `S` on `active`, from the rows before it;
-/// `false` when the row is (nearly) a combination of them.
+/// Row `i` of the Cholesky factor of `S` on `active`, from the rows before it and
+/// the column of `S` at `active[i]`; `false` when the row is (nearly) a combination
+/// of them.
 fn factor_row(
-    schur: &[f64],
+    column: &[f64],
     n: usize,
     active: &[usize],
     i: usize,
@@ -282,13 +350,13 @@ fn factor_row(
     let c = active[i];
     // L[..i] l = S[active[..i], c], forward.
     for r in 0..i {
-        let mut value = schur[active[r] * n + c];
+        let mut value = column[active[r]];
         for j in 0..r {
             value -= factor[r * n + j] * work[j];
         }
         work[r] = value / factor[r * n + r];
     }
-    let diagonal = schur[c * n + c];
+    let diagonal = column[c];
     let remaining = diagonal - work[..i].iter().map(|l| l * l).sum::<f64>();
     factor[i * n..i * n + i].copy_from_slice(&work[..i]);
     factor[i * n + i] = remaining.max(DEPENDENT * diagonal).sqrt();
@@ -331,6 +399,31 @@ mod tests {
         }
         let q = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         (s, q)
+    }
+
+    fn dense(s: &[f64]) -> DenseSchur<'_> {
+        let n = (s.len() as f64).sqrt().round() as usize;
+        DenseSchur::new(s, n)
+    }
+
+    /// A matrix that forms its columns when asked, recording which, and ranks rows by
+    /// a scale other than `√S_cc` (as the contact projection's does).
+    struct Recording<'a> {
+        matrix: &'a [f64],
+        n: usize,
+        asked: Vec<bool>,
+        scale: Vec<f64>,
+    }
+
+    impl Schur for Recording<'_> {
+        fn column(&mut self, c: usize) -> &[f64] {
+            self.asked[c] = true;
+            &self.matrix[c * self.n..(c + 1) * self.n]
+        }
+
+        fn scale(&self, c: usize) -> f64 {
+            self.scale[c]
+        }
     }
 
     fn residual_of(s: &[f64], q: &[f64], mu: &[f64]) -> Vec<f64> {
@@ -385,7 +478,7 @@ mod tests {
             let n = rng.random_range(1..=8);
             let (s, q) = random_problem(n, n + 2, &mut rng);
             let (mut mu, mut w) = (vec![0.0; n], vec![0.0; n]);
-            active_set(&s, &q, 1e-14, &mut mu, &mut w, &mut scratch).unwrap();
+            active_set(&mut dense(&s), &q, 1e-14, &mut mu, &mut w, &mut scratch).unwrap();
             let expected = brute_force(&s, &q);
             for (a, b) in mu.iter().zip(&expected) {
                 assert!(
@@ -398,6 +491,77 @@ mod tests {
                 assert!((a - b).abs() <= 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn pivoting_reads_only_the_columns_of_rows_that_enter_whatever_the_scale() {
+        let mut rng = StdRng::seed_from_u64(23);
+        let mut scratch = ActiveSetScratch::default();
+        let mut untouched = 0;
+        for _ in 0..200 {
+            let n = rng.random_range(1..=10);
+            let (s, q) = random_problem(n, n + 2, &mut rng);
+            let mut recording = Recording {
+                matrix: &s,
+                n,
+                asked: vec![false; n],
+                // An upper bound of √S_cc within a factor of three, like √(N W Nᵀ)_cc.
+                scale: (0..n)
+                    .map(|c| s[c * n + c].sqrt() * rng.random_range(1.0..3.0))
+                    .collect(),
+            };
+            let (mut mu, mut w) = (vec![0.0; n], vec![0.0; n]);
+            active_set(&mut recording, &q, 1e-14, &mut mu, &mut w, &mut scratch).unwrap();
+            let expected = brute_force(&s, &q);
+            for (a, b) in mu.iter().zip(&expected) {
+                assert!(
+                    (a - b).abs() <= 1e-9 * (1.0 + b.abs()),
+                    "{mu:?} {expected:?}"
+                );
+            }
+            for c in 0..n {
+                // A row that never needed an impulse is never read.
+                if q[c] >= 0.0 && !recording.asked[c] {
+                    untouched += 1;
+                }
+                if mu[c] > 0.0 {
+                    assert!(recording.asked[c], "row {c} took an impulse unread");
+                }
+                if !recording.asked[c] {
+                    assert_eq!(mu[c], 0.0);
+                }
+            }
+        }
+        // Random problems with q ≥ 0 rows: many columns are never formed.
+        assert!(untouched > 200, "{untouched}");
+    }
+
+    #[test]
+    fn gauss_seidel_reads_only_the_columns_of_rows_that_move() {
+        let s = [2.0, 0.5, 0.0, 0.5, 2.0, 0.0, 0.0, 0.0, 2.0];
+        let mut recording = Recording {
+            matrix: &s,
+            n: 3,
+            asked: vec![false; 3],
+            scale: vec![1.0; 3],
+        };
+        let (mut mu, mut w) = ([0.0; 3], [0.0; 3]);
+        // Row 2 needs no impulse, and nothing pushes it: its column stays unformed.
+        projected_gauss_seidel(
+            &mut recording,
+            &[-1.0, -1.0, 0.3],
+            1e-14,
+            100,
+            &mut mu,
+            &mut w,
+        );
+        assert_eq!(recording.asked, [true, true, false]);
+        assert_eq!(mu[2], 0.0);
+        // 2μ₀ + ½μ₁ = 1 = ½μ₀ + 2μ₁.
+        assert!(
+            (mu[0] - 0.4).abs() < 1e-12 && (mu[1] - 0.4).abs() < 1e-12,
+            "{mu:?}"
+        );
     }
 
     #[test]
@@ -428,7 +592,7 @@ mod tests {
                 })
                 .collect();
             let (mut mu, mut w) = (vec![0.0; n], vec![0.0; n]);
-            if active_set(&s, &q, tolerance, &mut mu, &mut w, &mut scratch).is_err() {
+            if active_set(&mut dense(&s), &q, tolerance, &mut mu, &mut w, &mut scratch).is_err() {
                 stalled += 1;
                 continue;
             }
@@ -461,8 +625,8 @@ mod tests {
             }
             let (mut a, mut wa) = (vec![0.0; n], vec![0.0; n]);
             let (mut b, mut wb) = (vec![0.0; n], vec![0.0; n]);
-            active_set(&s, &q, 1e-13, &mut a, &mut wa, &mut scratch).unwrap();
-            let sweeps = projected_gauss_seidel(&s, &q, 1e-13, 200, &mut b, &mut wb);
+            active_set(&mut dense(&s), &q, 1e-13, &mut a, &mut wa, &mut scratch).unwrap();
+            let sweeps = projected_gauss_seidel(&mut dense(&s), &q, 1e-13, 200, &mut b, &mut wb);
             assert!(
                 sweeps < 200,
                 "diagonally dominant: converges before the cap"
@@ -480,7 +644,10 @@ mod tests {
         let s = [1.0, -1.0, -1.0, 1.0];
         let q = [-1.0, -1.0];
         let (mut mu, mut w) = ([0.0; 2], [0.0; 2]);
-        assert_eq!(projected_gauss_seidel(&s, &q, 1e-12, 7, &mut mu, &mut w), 7);
+        assert_eq!(
+            projected_gauss_seidel(&mut dense(&s), &q, 1e-12, 7, &mut mu, &mut w),
+            7
+        );
         assert!(mu.iter().all(|m| m.is_finite() && *m > 0.0), "{mu:?}");
     }
 
@@ -489,7 +656,7 @@ mod tests {
         let mut scratch = ActiveSetScratch::default();
         let (mut mu, mut w) = (vec![1.0; 2], vec![0.0; 2]);
         let pivots = active_set(
-            &[2.0, 1.0, 1.0, 2.0],
+            &mut dense(&[2.0, 1.0, 1.0, 2.0]),
             &[0.5, 0.0],
             0.0,
             &mut mu,
@@ -508,7 +675,15 @@ mod tests {
         let mut scratch = ActiveSetScratch::default();
         let (mut mu, mut w) = (vec![0.0; 2], vec![0.0; 2]);
         let schur = [1.0, -1.0, -1.0, 1.0];
-        active_set(&schur, &[-1.0, -0.5], 1e-12, &mut mu, &mut w, &mut scratch).unwrap();
+        active_set(
+            &mut dense(&schur),
+            &[-1.0, -0.5],
+            1e-12,
+            &mut mu,
+            &mut w,
+            &mut scratch,
+        )
+        .unwrap();
         assert_eq!(mu, [1.0, 0.0]);
         assert_eq!(w, [0.0, -1.5]);
     }

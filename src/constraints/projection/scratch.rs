@@ -46,6 +46,8 @@ pub struct IslandScratch {
     pub(super) column_entries: Vec<(u32, f64)>,
     pub(super) solved_columns: Vec<f64>,
     pub(super) schur: Vec<f64>,
+    /// Which columns of `schur` (and of `solved_columns`) the current step formed.
+    pub(super) formed: Vec<bool>,
     pub(super) offset: Vec<f64>,
     pub(super) impulse: Vec<f64>,
     pub(super) contact_residual: Vec<f64>,
@@ -87,6 +89,7 @@ impl IslandScratch {
         grow(&mut self.columns, rows, 0..0);
         grow(&mut self.solved_columns, rows * edges, 0.0);
         grow(&mut self.schur, rows * rows, 0.0);
+        grow(&mut self.formed, rows, false);
         grow(&mut self.offset, rows, 0.0);
         grow(&mut self.impulse, rows, 0.0);
         grow(&mut self.contact_residual, rows, 0.0);
