@@ -288,14 +288,20 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
             break;
         }
     }
-    let blocked: u64 = world
+    let (blocked, withdrawn) = world
         .query::<&SpaghettiFactory>()
         .iter(world)
-        .map(|f| f.progress.blocked_ticks)
-        .sum();
+        .fold((0u64, 0u64), |(b, w), f| {
+            (b + f.progress.blocked_ticks, w + f.progress.withdrawn)
+        });
     if blocked > 0 {
         notes.push(format!(
             "the spaghetti factory's inlet was blocked for {blocked} ticks: its rollers stood still"
+        ));
+    }
+    if withdrawn > 0 {
+        notes.push(format!(
+            "the spaghetti factory withdrew {withdrawn} lone first particles from its blocked inlet"
         ));
     }
     let simulated = world.resource::<SimulationClock>().time - start_time;

@@ -35,6 +35,9 @@ pub struct SpaghettiProgressRecord {
     /// Ticks the inlet has been blocked, in all.
     #[serde(default)]
     pub blocked_ticks: u64,
+    /// Lone particles withdrawn from the blocked inlet.
+    #[serde(default)]
+    pub withdrawn: u64,
 }
 
 /// A furry creature's driven particles, by snapshot number, with their offsets.
@@ -113,6 +116,7 @@ impl RunSnapshot {
                     .and_then(|s| entities.strand_number(s)),
                 blocked: f.progress.blocked,
                 blocked_ticks: f.progress.blocked_ticks,
+                withdrawn: f.progress.withdrawn,
             });
         let meatball_factory = world
             .query::<&MeatballFactory>()
@@ -166,6 +170,7 @@ impl RunSnapshot {
                     .and_then(|s| entities.strands.get(s as usize).copied()),
                 blocked: progress.blocked,
                 blocked_ticks: progress.blocked_ticks,
+                withdrawn: progress.withdrawn,
             };
             world.spawn(factory);
         }

@@ -70,6 +70,8 @@ pub struct SpaghettiProgress {
     pub blocked: bool,
     /// Ticks the inlet has been blocked, in all.
     pub blocked_ticks: u64,
+    /// Lone particles withdrawn from a blocked inlet (see [`run_spaghetti_factories`]).
+    pub withdrawn: u64,
 }
 
 /// An inlet emitting strands. Add it to an entity; the factory system does the rest.
@@ -143,6 +145,17 @@ pub fn run_spaghetti_factories(
             // The extrusion stands still: so does its schedule.
             factory.progress.next_emission += tick;
             factory.progress.blocked_ticks += 1;
+            // A strand's first particle, alone and pinned at the inlet, can be what
+            // holds up the tail that blocks it (a strand hooked on it hangs there for
+            // ever while the rollers wait): it is withdrawn, and emitted again once
+            // the inlet is clear. Taking a particle away crosses nothing.
+            let progress = &mut factory.progress;
+            if progress.current_strand.is_none() && progress.current.len() == 1 {
+                commands.entity(progress.current[0]).despawn();
+                progress.current.clear();
+                progress.strands_started -= 1;
+                progress.withdrawn += 1;
+            }
             continue;
         }
         let interval = factory.spec.interval;
