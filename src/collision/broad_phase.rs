@@ -61,8 +61,14 @@ const MAX_CELLS_PER_EDGE: i64 = 4096;
 #[derive(Clone, Debug, Default)]
 pub struct BroadPhase {
     edge_boxes: Vec<Aabb>,
+    /// Each edge's cell range, `None` when oversized: computed once per build.
+    edge_cells: Vec<Option<CellRange>>,
     cell_size: f64,
     mask: usize,
+    /// The cells every entered box lies in, when few enough to index directly (row by
+    /// row: the edges of a strand, entered one after another, fill neighbouring
+    /// buckets); `None`: the cells are hashed.
+    dense: Option<CellRange>,
     bucket_start: Vec<u32>,
     entries: Vec<u32>,
     oversized: Vec<u32>,
@@ -70,26 +76,53 @@ pub struct BroadPhase {
     seen: Vec<u32>,
 }
 
+/// Cells `x0..=x1` by `y0..=y1`.
+type CellRange = (i64, i64, i64, i64);
+
+/// `v.floor() as i64`, without the library call `floor` is on baseline x86-64 (it was
+/// a tenth of a step in free fall): the same value for every `v`, ±∞ and NaN included.
+fn floor_to_i64(v: f64) -> i64 {
+    let truncated = v as i64;
+    if (truncated as f64) > v {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
+}
+
 fn hash(ix: i64, iy: i64, mask: usize) -> usize {
     ((ix.wrapping_mul(73_856_093) ^ iy.wrapping_mul(19_349_663)) as u64 as usize) & mask
 }
 
+/// A grid of at most this many cells per edge is indexed directly, not hashed.
+const DENSE_CELLS_PER_EDGE: i64 = 8;
+
 impl BroadPhase {
-    fn cell_range(&self, b: &Aabb) -> (i64, i64, i64, i64) {
-        let f = |v: f64| (v / self.cell_size).floor() as i64;
+    fn cell_range(&self, b: &Aabb) -> CellRange {
+        let f = |v: f64| floor_to_i64(v / self.cell_size);
         (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y))
     }
 
-    /// Whether a box is better tested against everything than entered in the grid.
-    fn is_oversized(&self, b: &Aabb) -> bool {
-        let (x0, y0, x1, y1) = self.cell_range(b);
-        !b.min.is_finite()
+    /// The bucket of a cell (inside the dense grid, when there is one).
+    fn bucket(&self, ix: i64, iy: i64) -> usize {
+        match self.dense {
+            Some((x0, y0, x1, _)) => ((iy - y0) * (x1 - x0 + 1) + (ix - x0)) as usize,
+            None => hash(ix, iy, self.mask),
+        }
+    }
+
+    /// The cells of a box, or `None` when it is better tested against everything than
+    /// entered in the grid.
+    fn cells(&self, b: &Aabb) -> Option<CellRange> {
+        let range @ (x0, y0, x1, y1) = self.cell_range(b);
+        let oversized = !b.min.is_finite()
             || !b.max.is_finite()
             || x1
                 .saturating_sub(x0)
                 .saturating_add(1)
                 .saturating_mul(y1.saturating_sub(y0).saturating_add(1))
-                > MAX_CELLS_PER_EDGE
+                > MAX_CELLS_PER_EDGE;
+        (!oversized).then_some(range)
     }
 
     /// Build the grid over every edge's swept box: positions `x`, end positions
@@ -129,23 +162,41 @@ impl BroadPhase {
         }
         // A cell about the size of a typical edge's box.
         self.cell_size = (extent / count as f64).max(1e-9);
-        let table = (2 * count).next_power_of_two();
-        self.mask = table - 1;
+        self.oversized.clear();
+        self.edge_cells.clear();
+        let mut bounds: Option<CellRange> = None;
+        for k in 0..self.edge_boxes.len() {
+            let cells = self.cells(&self.edge_boxes[k]);
+            self.edge_cells.push(cells);
+            match (cells, &mut bounds) {
+                (None, _) => self.oversized.push(k as u32),
+                (Some(c), None) => bounds = Some(c),
+                (Some(c), Some(b)) => {
+                    *b = (b.0.min(c.0), b.1.min(c.1), b.2.max(c.2), b.3.max(c.3));
+                }
+            }
+        }
+        self.dense = bounds.filter(|&(x0, y0, x1, y1)| {
+            let cells = (x1 - x0 + 1).saturating_mul(y1 - y0 + 1);
+            cells <= DENSE_CELLS_PER_EDGE.saturating_mul(count as i64)
+        });
+        let table = match self.dense {
+            Some((x0, y0, x1, y1)) => ((x1 - x0 + 1) * (y1 - y0 + 1)) as usize,
+            None => (2 * count).next_power_of_two(),
+        };
+        self.mask = table.next_power_of_two() - 1;
         self.bucket_start.clear();
         self.bucket_start.resize(table + 1, 0);
-        self.oversized.clear();
 
         // Count, prefix-sum, fill: a counting sort of (bucket, edge) entries.
         for k in 0..self.edge_boxes.len() {
-            let b = self.edge_boxes[k];
-            if self.is_oversized(&b) {
-                self.oversized.push(k as u32);
+            let Some((x0, y0, x1, y1)) = self.edge_cells[k] else {
                 continue;
-            }
-            let (x0, y0, x1, y1) = self.cell_range(&b);
-            for ix in x0..=x1 {
-                for iy in y0..=y1 {
-                    self.bucket_start[hash(ix, iy, self.mask) + 1] += 1;
+            };
+            for iy in y0..=y1 {
+                for ix in x0..=x1 {
+                    let bucket = self.bucket(ix, iy);
+                    self.bucket_start[bucket + 1] += 1;
                 }
             }
         }
@@ -157,14 +208,12 @@ impl BroadPhase {
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.bucket_start[..table]);
         for k in 0..self.edge_boxes.len() {
-            let b = self.edge_boxes[k];
-            if self.is_oversized(&b) {
+            let Some((x0, y0, x1, y1)) = self.edge_cells[k] else {
                 continue;
-            }
-            let (x0, y0, x1, y1) = self.cell_range(&b);
-            for ix in x0..=x1 {
-                for iy in y0..=y1 {
-                    let bucket = hash(ix, iy, self.mask);
+            };
+            for iy in y0..=y1 {
+                for ix in x0..=x1 {
+                    let bucket = self.bucket(ix, iy);
                     self.entries[self.cursor[bucket] as usize] = k as u32;
                     self.cursor[bucket] += 1;
                 }
@@ -174,8 +223,20 @@ impl BroadPhase {
 
     /// Visit each edge whose box overlaps `query` once (in a fixed order). `stamp`
     /// must differ between consecutive queries and be non-zero.
-    fn visit(&mut self, query: &Aabb, stamp: u32, mut visit: impl FnMut(u32)) {
-        if self.is_oversized(query) {
+    fn visit(&mut self, query: &Aabb, stamp: u32, visit: impl FnMut(u32)) {
+        let cells = self.cells(query);
+        self.visit_cells(query, cells, stamp, visit);
+    }
+
+    /// [`BroadPhase::visit`] with the query's cells known.
+    fn visit_cells(
+        &mut self,
+        query: &Aabb,
+        cells: Option<CellRange>,
+        stamp: u32,
+        mut visit: impl FnMut(u32),
+    ) {
+        let Some((x0, y0, x1, y1)) = cells else {
             // A huge query: test every edge.
             for k in 0..self.edge_boxes.len() as u32 {
                 if self.edge_boxes[k as usize].overlaps(query) {
@@ -183,11 +244,15 @@ impl BroadPhase {
                 }
             }
             return;
-        }
-        let (x0, y0, x1, y1) = self.cell_range(query);
-        for ix in x0..=x1 {
-            for iy in y0..=y1 {
-                let bucket = hash(ix, iy, self.mask);
+        };
+        // Cells outside a dense grid hold nothing.
+        let (x0, y0, x1, y1) = match self.dense {
+            Some(g) => (x0.max(g.0), y0.max(g.1), x1.min(g.2), y1.min(g.3)),
+            None => (x0, y0, x1, y1),
+        };
+        for iy in y0..=y1 {
+            for ix in x0..=x1 {
+                let bucket = self.bucket(ix, iy);
                 for slot in self.bucket_start[bucket]..self.bucket_start[bucket + 1] {
                     let k = self.entries[slot as usize];
                     if self.seen[k as usize] != stamp {
@@ -258,11 +323,13 @@ impl BroadPhase {
         for j in 0..self.edge_boxes.len() as u32 {
             let query = self.edge_boxes[j as usize];
             match method {
-                BroadPhaseMethod::Grid => self.visit(&query, j + 1, |k| {
-                    if k > j && keep(j, k) {
-                        pairs.push((j, k));
-                    }
-                }),
+                BroadPhaseMethod::Grid => {
+                    self.visit_cells(&query, self.edge_cells[j as usize], j + 1, |k| {
+                        if k > j && keep(j, k) {
+                            pairs.push((j, k));
+                        }
+                    })
+                }
                 BroadPhaseMethod::BruteForce => {
                     for k in j + 1..self.edge_boxes.len() as u32 {
                         if self.edge_boxes[k as usize].overlaps(&query) && keep(j, k) {
@@ -315,11 +382,29 @@ mod tests {
     #[test]
     fn grid_and_brute_force_find_the_same_pairs() {
         let mut rng = StdRng::seed_from_u64(9);
-        for strands in [1, 10, 100] {
-            let (position, displacement, edges) = random_scene(&mut rng, strands);
+        let mut dense_seen = false;
+        for (strands, far) in [
+            (1, false),
+            (10, false),
+            (100, false),
+            (10, true),
+            (100, true),
+        ] {
+            let (mut position, mut displacement, mut edges) = random_scene(&mut rng, strands);
+            if far {
+                // One edge far away: too many cells between to index, so they are hashed.
+                let n = position.len() as u32;
+                position.extend([DVec2::splat(1e3), DVec2::splat(1e3 + 0.01)]);
+                displacement.extend([DVec2::ZERO; 2]);
+                edges.push(Edge::new(n, n + 1, 0.01));
+            }
             let keep = |p: u32, k: u32| edges[k as usize].a != p && edges[k as usize].b != p;
             let mut broad = BroadPhase::default();
             broad.build(&edges, &position, Some(&displacement), 0.004);
+            if far {
+                assert!(broad.dense.is_none(), "{strands} strands: hashed");
+            }
+            dense_seen |= broad.dense.is_some();
             let (mut grid, mut brute) = (Vec::new(), Vec::new());
             broad.point_edge_pairs(
                 BroadPhaseMethod::Grid,
@@ -337,14 +422,15 @@ mod tests {
             );
             grid.sort_unstable();
             brute.sort_unstable();
-            assert_eq!(grid, brute, "{strands} strands");
+            assert_eq!(grid, brute, "{strands} strands, far {far}");
             assert!(!grid.is_empty());
             let (mut grid, mut brute) = (Vec::new(), Vec::new());
             broad.edge_edge_pairs(BroadPhaseMethod::Grid, |_, _| true, &mut grid);
             broad.edge_edge_pairs(BroadPhaseMethod::BruteForce, |_, _| true, &mut brute);
             grid.sort_unstable();
             brute.sort_unstable();
-            assert_eq!(grid, brute, "{strands} strands");
+            assert_eq!(grid, brute, "{strands} strands, far {far}");
         }
+        assert!(dense_seen, "a crowded scene is indexed directly");
     }
 }
