@@ -63,7 +63,9 @@ pub struct BroadPhase {
     edge_boxes: Vec<Aabb>,
     /// Each edge's cell range, `None` when oversized: computed once per build.
     edge_cells: Vec<Option<CellRange>>,
-    cell_size: f64,
+    /// One over the cell's side: cells are found by a product, not a division (four
+    /// per box, the build's longest latency).
+    inverse_cell: f64,
     mask: usize,
     /// The cells every entered box lies in, when few enough to index directly (row by
     /// row: the edges of a strand, entered one after another, fill neighbouring
@@ -99,7 +101,7 @@ const DENSE_CELLS_PER_EDGE: i64 = 8;
 
 impl BroadPhase {
     fn cell_range(&self, b: &Aabb) -> CellRange {
-        let f = |v: f64| floor_to_i64(v / self.cell_size);
+        let f = |v: f64| floor_to_i64(v * self.inverse_cell);
         (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y))
     }
 
@@ -161,7 +163,7 @@ impl BroadPhase {
             self.edge_boxes.push(b);
         }
         // A cell about the size of a typical edge's box.
-        self.cell_size = (extent / count as f64).max(1e-9);
+        self.inverse_cell = 1.0 / (extent / count as f64).max(1e-9);
         self.oversized.clear();
         self.edge_cells.clear();
         let mut bounds: Option<CellRange> = None;
