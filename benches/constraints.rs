@@ -1,5 +1,6 @@
 //! Criterion benchmarks of the constraint solve: the Thomas kernel per unknown, one
-//! Constrain stage (every island projected once) on 1000 strands of 100 particles, and
+//! Constrain stage (every island projected once) on 1000 strands of 100 particles (the
+//! kernel in a loop, and the plugin's islands on one and two threads), and
 //! one projection of a tree and of a graph of about 2000 edges (sparse LDLᵀ) beside a
 //! chain of as many edges.
 //!
@@ -10,12 +11,16 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
+use bevy_strands::constraints::Islands;
 use bevy_strands::constraints::graph::GraphLayout;
 use bevy_strands::constraints::island_edge::IslandEdge;
+use bevy_strands::constraints::islands::find_islands;
 use bevy_strands::constraints::projection::{
     Bodies, Chain, Graph, IslandScratch, IslandView, project_chain, project_island,
 };
 use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
+use bevy_strands::metrics::IterationStats;
+use bevy_strands::model::Edge;
 use bevy_strands::prelude::*;
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::StdRng;
@@ -141,6 +146,31 @@ fn constraint_stage(c: &mut Criterion) {
             total
         })
     });
+    // The same stage through the plugin's islands, on one thread and on two.
+    let model_edges: Vec<Edge> = (pile.edges.iter())
+        .map(|e| Edge::new(e.a, e.b, e.rest_length))
+        .collect();
+    let mut islands = Islands::default();
+    islands.set = find_islands(&model_edges, &vec![false; pile.position.len()]);
+    islands.solved = (0..islands.set.islands.len()).collect();
+    let mut stats = IterationStats::default();
+    for threads in [1, 2] {
+        group.bench_function(BenchmarkId::new("1000x100/islands", threads), |b| {
+            let mut velocity = pile.velocity.clone();
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                for _ in 0..iters {
+                    velocity.copy_from_slice(&pile.velocity);
+                    let start = Instant::now();
+                    let mut bodies = Bodies::new(&pile.position, &mut velocity, &pile.inverse_mass);
+                    islands.project(&mut bodies, dt, &settings, &mut stats, threads);
+                    total += start.elapsed();
+                }
+                black_box(&velocity);
+                total
+            })
+        });
+    }
     group.finish();
 }
 

@@ -62,6 +62,15 @@ impl IterationStats {
         self.capped += u64::from(!outcome.converged && !outcome.rejected);
     }
 
+    /// Add the counts of `other` (solves recorded elsewhere, e.g. on another thread).
+    pub fn merge(&mut self, other: &IterationStats) {
+        self.solves += other.solves;
+        self.iterations += other.iterations;
+        self.max = self.max.max(other.max);
+        self.capped += other.capped;
+        self.rejected += other.rejected;
+    }
+
     /// Mean iterations per solve (0 before any solve).
     pub fn mean(&self) -> f64 {
         if self.solves == 0 {

@@ -120,6 +120,8 @@ pub struct Report {
     /// Steps whose collisions still needed impulses after the last re-projection:
     /// edges next to those contacts end the step as the impulses left them.
     pub contact_unsettled_steps: u64,
+    /// Threads a stage could use; the wall-clock figures depend on it, nothing else does.
+    pub threads: usize,
     /// Wall-clock seconds of the run's ticks.
     pub wall_seconds: f64,
     /// Particles × steps per wall-clock second.
@@ -136,7 +138,8 @@ pub struct Report {
 
 impl Report {
     /// The fields measured by the wall clock: they differ between identical runs.
-    pub const WALL_CLOCK_FIELDS: [&'static str; 3] = [
+    pub const WALL_CLOCK_FIELDS: [&'static str; 4] = [
+        "threads",
         "wall_seconds",
         "particle_steps_per_second",
         "real_time_factor",
@@ -203,6 +206,7 @@ impl Report {
                     self.contact_unsettled_steps
                 ),
             ),
+            ("threads", self.threads.to_string()),
             ("wall_seconds", format!("{:.3}", self.wall_seconds)),
             (
                 "particle_steps_per_second",

@@ -37,6 +37,9 @@ pub struct RunOptions {
     pub dt: Option<f64>,
     /// Steps per tick, instead of the scene's.
     pub substeps: Option<u32>,
+    /// Threads a stage may use (0 or `None`: one per core); the report is the same
+    /// whatever the count.
+    pub threads: Option<usize>,
     /// Constraint solver, instead of the scene's.
     pub solver: Option<String>,
     /// Projection iteration cap, instead of the scene's.
@@ -128,6 +131,9 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
     }
     if let Some(substeps) = options.substeps {
         scenario.step.substeps = substeps;
+    }
+    if let Some(threads) = options.threads {
+        scenario.step.threads = threads;
     }
     if let Some(solver) = &options.solver {
         scenario.constraints.solver = solver.parse().map_err(|e| command_line("--solver", e))?;
@@ -427,6 +433,7 @@ fn report(
         contact_projection_capped_solves: metrics.contact_projection.capped,
         contact_projection_rejected_solves: metrics.contact_projection.rejected,
         contact_unsettled_steps: metrics.contact_unsettled_steps,
+        threads: world.resource::<StrandsConfig>().worker_threads(),
         wall_seconds,
         particle_steps_per_second: if wall_seconds > 0.0 {
             particle_steps as f64 / wall_seconds

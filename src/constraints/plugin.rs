@@ -1,6 +1,7 @@
 //! The Constrain stage's systems and the islands they solve: found once per topology
 //! change, each projected every step by the kernel its kind calls for.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::island_edge::IslandEdge;
@@ -41,6 +42,22 @@ pub struct Islands {
     rows: Vec<ContactRow>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
+    lanes: Vec<Lane>,
+}
+
+/// Below this many edges in all the Constrain stage stays on one thread: starting
+/// threads would cost more than the solves they share.
+const PARALLEL_EDGES: usize = 4096;
+
+/// One extra thread's share of a parallel Constrain stage: a copy of the velocities to
+/// write its islands' into, its buffers, and its counts.
+#[derive(Debug, Default)]
+struct Lane {
+    velocity: Vec<DVec2>,
+    scratch: IslandScratch,
+    stats: IterationStats,
+    /// Its slots of `Islands::solved`.
+    slots: std::ops::Range<usize>,
 }
 
 impl Islands {
@@ -63,31 +80,98 @@ impl Islands {
     }
 
     fn view(&self, island: usize) -> IslandView<'_> {
-        let island = &self.set.islands[island];
-        let edges = &self.set.edges[island.edges.clone()];
-        match island.graph {
-            Some(g) => IslandView::Graph(Graph {
-                edges,
-                layout: &self.set.graphs[g],
-            }),
-            None => IslandView::Chain(Chain {
-                edges,
-                closed: island.kind == IslandKind::Cycle,
-            }),
-        }
+        island_view(&self.set, island)
     }
 
     /// Project every solved island (the Constrain stage), recording each solve.
+    ///
+    /// With `threads` above one and enough edges, contiguous shares of the islands
+    /// (about equal in edges) are projected on that many threads. An island's solve
+    /// reads and writes its own particles only, the same whichever thread does it, so
+    /// the velocities and counts are the same bit for bit whatever the thread count.
     pub fn project(
         &mut self,
         bodies: &mut Bodies,
         dt: f64,
         settings: &ProjectionSettings,
         stats: &mut IterationStats,
+        threads: usize,
     ) {
-        for slot in 0..self.solved.len() {
-            let i = self.solved[slot];
-            self.project_island(i, bodies, &[], dt, settings, stats);
+        let edges: usize = (self.solved.iter())
+            .map(|&i| self.set.islands[i].edges.len())
+            .sum();
+        let threads = threads.min(self.solved.len());
+        if threads <= 1 || edges < PARALLEL_EDGES {
+            for slot in 0..self.solved.len() {
+                let i = self.solved[slot];
+                self.project_island(i, bodies, &[], dt, settings, stats);
+            }
+            return;
+        }
+        let Islands {
+            set,
+            solved,
+            scratch,
+            lanes,
+            ..
+        } = self;
+        lanes.resize_with(threads - 1, Lane::default);
+        // Share boundaries: slot where the running edge count passes t/threads of all.
+        let mut first = 0..solved.len();
+        let (mut slot, mut count) = (0, 0);
+        for t in 0..threads {
+            let start = slot;
+            let goal = edges * (t + 1) / threads;
+            while slot < solved.len() && (count < goal || t + 1 == threads) {
+                count += set.islands[solved[slot]].edges.len();
+                slot += 1;
+            }
+            match t {
+                0 => first = start..slot,
+                _ => lanes[t - 1].slots = start..slot,
+            }
+        }
+        let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
+        for lane in lanes.iter_mut() {
+            lane.velocity.clear();
+            lane.velocity.extend_from_slice(bodies.velocity);
+            lane.stats = IterationStats::default();
+        }
+        let (set, solved) = (&*set, &*solved);
+        std::thread::scope(|scope| {
+            for lane in lanes.iter_mut() {
+                scope.spawn(move || {
+                    let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass);
+                    for slot in lane.slots.clone() {
+                        let view = island_view(set, solved[slot]);
+                        project_met(
+                            view,
+                            &mut own,
+                            &[],
+                            dt,
+                            settings,
+                            &mut lane.scratch,
+                            &mut lane.stats,
+                        );
+                    }
+                });
+            }
+            for slot in first {
+                let view = island_view(set, solved[slot]);
+                project_met(view, bodies, &[], dt, settings, scratch, stats);
+            }
+        });
+        // Each lane's islands' velocities back; a pinned particle two islands share is
+        // never written, so its copy is the value it had.
+        for lane in lanes.iter() {
+            for slot in lane.slots.clone() {
+                for e in &set.edges[set.islands[solved[slot]].edges.clone()] {
+                    for j in [e.a as usize, e.b as usize] {
+                        bodies.velocity[j] = lane.velocity[j];
+                    }
+                }
+            }
+            stats.merge(&lane.stats);
         }
     }
 
@@ -345,6 +429,22 @@ impl Islands {
     }
 }
 
+/// The view of island `island` of `set`.
+fn island_view(set: &IslandSet, island: usize) -> IslandView<'_> {
+    let island = &set.islands[island];
+    let edges = &set.edges[island.edges.clone()];
+    match island.graph {
+        Some(g) => IslandView::Graph(Graph {
+            edges,
+            layout: &set.graphs[g],
+        }),
+        None => IslandView::Chain(Chain {
+            edges,
+            closed: island.kind == IslandKind::Cycle,
+        }),
+    }
+}
+
 /// Project `view`, record the solve, and tell whether it met its edges.
 fn project_met(
     view: IslandView,
@@ -493,6 +593,12 @@ pub fn solve_constraints(
             &settings,
             &mut metrics.projection,
         ),
-        None => islands.project(&mut bodies, step.dt, &settings, &mut metrics.projection),
+        None => islands.project(
+            &mut bodies,
+            step.dt,
+            &settings,
+            &mut metrics.projection,
+            step.worker_threads(),
+        ),
     }
 }

@@ -51,6 +51,10 @@ pub struct StrandsConfig {
     /// Whether ticks advance the simulation. A paused simulation keeps its state.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub paused: bool,
+    /// Threads a stage may use (0: one per core). Results are the same bit for bit
+    /// whatever the count; on the web there is one.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub threads: usize,
 }
 
 impl Default for StrandsConfig {
@@ -62,6 +66,7 @@ impl Default for StrandsConfig {
             damping: 0.0,
             material: StrandMaterial::default(),
             paused: false,
+            threads: 0,
         }
     }
 }
@@ -70,6 +75,20 @@ impl StrandsConfig {
     /// Simulated seconds per fixed tick.
     pub fn tick_seconds(&self) -> f64 {
         self.dt * self.substeps as f64
+    }
+
+    /// The threads a stage uses: [`StrandsConfig::threads`], with 0 meaning one per
+    /// core, and one where threads cannot be spawned (wasm32).
+    pub fn worker_threads(&self) -> usize {
+        if cfg!(target_arch = "wasm32") {
+            return 1;
+        }
+        // Asking the system reads files (and allocates): once per process.
+        static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+        match self.threads {
+            0 => *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+            n => n,
+        }
     }
 
     /// Check every number against its meaning.

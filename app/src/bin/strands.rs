@@ -48,6 +48,10 @@ struct RunArgs {
     /// Steps per tick (default: the scene's).
     #[arg(long, value_name = "N")]
     substeps: Option<u32>,
+    /// Threads a stage may use (default 0: one per core). The report is the same bit
+    /// for bit whatever the count.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
@@ -149,6 +153,7 @@ fn main() -> ExitCode {
                 seconds: args.seconds,
                 dt: args.dt,
                 substeps: args.substeps,
+                threads: args.threads,
                 solver: args.solver,
                 iterations: args.iterations,
                 stretch_springs: args.stretch_springs,
