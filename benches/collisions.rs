@@ -72,34 +72,41 @@ fn collide_stage(c: &mut Criterion) {
                 // 10¹⁰ box tests per detection pass: minutes per sample.
                 continue;
             }
-            let (mut app, velocity) = pile(particles, method);
-            let world = app.world_mut();
-            world
-                .resource_mut::<ParticleState>()
-                .velocity
-                .copy_from_slice(&velocity);
-            run_collide_stage(world);
-            let impulses = world.resource::<StrandMetrics>().collisions_last_step;
-            eprintln!("{particles} particles, {method:?}: {impulses} impulses per stage");
-            group.throughput(Throughput::Elements(particles as u64));
-            let name = format!("{method:?}").to_lowercase();
-            group.bench_function(BenchmarkId::new(name, particles), |b| {
-                b.iter_custom(|iters| {
-                    let mut total = Duration::ZERO;
-                    for _ in 0..iters {
-                        let world = app.world_mut();
-                        world
-                            .resource_mut::<ParticleState>()
-                            .velocity
-                            .copy_from_slice(&velocity);
-                        let start = Instant::now();
-                        run_collide_stage(world);
-                        black_box(&world.resource::<ParticleState>().velocity);
-                        total += start.elapsed();
-                    }
-                    total
-                })
-            });
+            let threads: &[usize] = match method {
+                BroadPhaseMethod::Grid => &[1, 2],
+                BroadPhaseMethod::BruteForce => &[1],
+            };
+            for &threads in threads {
+                let (mut app, velocity) = pile(particles, method);
+                let world = app.world_mut();
+                world.resource_mut::<StrandsConfig>().threads = threads;
+                world
+                    .resource_mut::<ParticleState>()
+                    .velocity
+                    .copy_from_slice(&velocity);
+                run_collide_stage(world);
+                let impulses = world.resource::<StrandMetrics>().collisions_last_step;
+                eprintln!("{particles} particles, {method:?}: {impulses} impulses per stage");
+                group.throughput(Throughput::Elements(particles as u64));
+                let name = format!("{}/{threads}t", format!("{method:?}").to_lowercase());
+                group.bench_function(BenchmarkId::new(name, particles), |b| {
+                    b.iter_custom(|iters| {
+                        let mut total = Duration::ZERO;
+                        for _ in 0..iters {
+                            let world = app.world_mut();
+                            world
+                                .resource_mut::<ParticleState>()
+                                .velocity
+                                .copy_from_slice(&velocity);
+                            let start = Instant::now();
+                            run_collide_stage(world);
+                            black_box(&world.resource::<ParticleState>().velocity);
+                            total += start.elapsed();
+                        }
+                        total
+                    })
+                });
+            }
         }
     }
     group.finish();

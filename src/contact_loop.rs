@@ -89,7 +89,7 @@ pub fn speculate(
         return;
     }
     let settings = contact_projection(&contact, &collisions, &constraints);
-    let impulse_settings = collisions.impulse_settings();
+    let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let keep = contact.keep * collisions.thickness;
     let buffers = &mut *buffers;
     let mut collider = collider(
@@ -179,7 +179,7 @@ pub fn contact_loop(
         return;
     }
     let settings = contact_projection(&contact, &collisions, &constraints);
-    let impulse_settings = collisions.impulse_settings();
+    let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let scratch = &mut *scratch;
     let mut changed = scratch.outcome.impulses > 0;
     let mut collider = collider(

@@ -14,23 +14,20 @@ fn figures(report: &Report) -> serde_json::Value {
     value
 }
 
-#[test]
-fn one_and_two_threads_give_the_same_report() {
-    // 50 strands of 100 particles: enough edges (4 950) for the Constrain stage to
-    // share its islands between threads; they land on the floor within the run.
+/// `scale` with `strands` strands of 100 particles for `seconds`, on one thread and
+/// on two: the same report.
+fn same_report_on_one_and_two_threads(strands: usize, seconds: f64) -> Report {
     let options = |threads| RunOptions {
         scenario: "scale".into(),
-        strands: Some(50),
+        strands: Some(strands),
         particles: Some(100),
-        seconds: Some(0.15),
+        seconds: Some(seconds),
         threads: Some(threads),
         check_crossings: true,
         ..Default::default()
     };
     let one = run(&options(1), |_| {}).unwrap();
     let two = run(&options(2), |_| {}).unwrap();
-    assert!(one.constrained_edges >= 4096, "{}", one.constrained_edges);
-    assert!(one.collisions > 0, "the strands reach the floor");
     assert_eq!((one.threads, two.threads), (1, 2));
     assert_eq!(figures(&one), figures(&two));
     assert!(
@@ -38,4 +35,28 @@ fn one_and_two_threads_give_the_same_report() {
         "{}",
         one.max_rel_length_error
     );
+    one
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_report() {
+    // 50 strands of 100 particles: enough edges (4 950) for the Constrain stage to
+    // share its islands between threads; they land on the floor within the run.
+    let report = same_report_on_one_and_two_threads(50, 0.15);
+    assert!(
+        report.constrained_edges >= 4096,
+        "{}",
+        report.constrained_edges
+    );
+    assert!(report.collisions > 0, "the strands reach the floor");
+}
+
+#[test]
+fn the_point_queries_shared_between_threads_give_the_same_report() {
+    // 170 strands of 100: enough points (17 000) for the broad phase's point queries
+    // to be shared too; the lowest strands reach the floor, so the pairs' order
+    // matters to the impulses.
+    let report = same_report_on_one_and_two_threads(170, 0.15);
+    assert!(report.particles >= 16_384, "{}", report.particles);
+    assert!(report.collisions > 0, "the strands reach the floor");
 }

@@ -76,6 +76,18 @@ pub struct BroadPhase {
     oversized: Vec<u32>,
     cursor: Vec<u32>,
     seen: Vec<u32>,
+    lanes: Vec<QueryLane>,
+}
+
+/// Below this many points the point queries stay on one thread.
+const PARALLEL_POINTS: usize = 16_384;
+
+/// One extra thread's share of the point queries: its points, its stamps, its pairs.
+#[derive(Clone, Debug, Default)]
+struct QueryLane {
+    points: std::ops::Range<usize>,
+    seen: Vec<u32>,
+    pairs: Vec<(u32, u32)>,
 }
 
 /// Cells `x0..=x1` by `y0..=y1`.
@@ -223,18 +235,14 @@ impl BroadPhase {
         }
     }
 
-    /// Visit each edge whose box overlaps `query` once (in a fixed order). `stamp`
-    /// must differ between consecutive queries and be non-zero.
-    fn visit(&mut self, query: &Aabb, stamp: u32, visit: impl FnMut(u32)) {
-        let cells = self.cells(query);
-        self.visit_cells(query, cells, stamp, visit);
-    }
-
-    /// [`BroadPhase::visit`] with the query's cells known.
+    /// Visit each edge whose box overlaps `query` (its cells `cells`) once, in a fixed
+    /// order. `stamp` must differ between consecutive queries on `seen` and be
+    /// non-zero.
     fn visit_cells(
-        &mut self,
+        &self,
         query: &Aabb,
         cells: Option<CellRange>,
+        seen: &mut [u32],
         stamp: u32,
         mut visit: impl FnMut(u32),
     ) {
@@ -257,8 +265,8 @@ impl BroadPhase {
                 let bucket = self.bucket(ix, iy);
                 for slot in self.bucket_start[bucket]..self.bucket_start[bucket + 1] {
                     let k = self.entries[slot as usize];
-                    if self.seen[k as usize] != stamp {
-                        self.seen[k as usize] = stamp;
+                    if seen[k as usize] != stamp {
+                        seen[k as usize] = stamp;
                         if self.edge_boxes[k as usize].overlaps(query) {
                             visit(k);
                         }
@@ -281,35 +289,96 @@ impl BroadPhase {
 
     /// Append every (point, edge) pair whose swept boxes overlap and for which `keep`
     /// holds, in point order (within a point, in an order fixed by the grid).
-    /// Call [`BroadPhase::build`] first.
+    /// Call [`BroadPhase::build`] first. With `threads` above one and enough points,
+    /// contiguous ranges of points are queried on that many threads and their pairs
+    /// appended in order: the same pairs in the same order whatever the count.
     pub fn point_edge_pairs(
         &mut self,
         method: BroadPhaseMethod,
+        threads: usize,
         position: &[DVec2],
         displacement: &[DVec2],
-        keep: impl Fn(u32, u32) -> bool,
+        keep: impl Fn(u32, u32) -> bool + Sync,
         pairs: &mut Vec<(u32, u32)>,
     ) {
         self.reset_seen();
-        for i in 0..position.len() {
-            let query = Aabb::swept(&[position[i], position[i] + displacement[i]], 0.0);
-            let point = i as u32;
-            match method {
-                BroadPhaseMethod::Grid => {
-                    self.visit(&query, point + 1, |k| {
-                        if keep(point, k) {
-                            pairs.push((point, k));
-                        }
-                    });
-                }
-                BroadPhaseMethod::BruteForce => {
-                    for k in 0..self.edge_boxes.len() as u32 {
-                        if self.edge_boxes[k as usize].overlaps(&query) && keep(point, k) {
-                            pairs.push((point, k));
-                        }
+        let n = position.len();
+        if method == BroadPhaseMethod::BruteForce {
+            for i in 0..n {
+                let query = Aabb::swept(&[position[i], position[i] + displacement[i]], 0.0);
+                for k in 0..self.edge_boxes.len() as u32 {
+                    if self.edge_boxes[k as usize].overlaps(&query) && keep(i as u32, k) {
+                        pairs.push((i as u32, k));
                     }
                 }
             }
+            return;
+        }
+        let threads = threads.min(n);
+        if threads <= 1 || n < PARALLEL_POINTS {
+            let mut seen = std::mem::take(&mut self.seen);
+            self.query_points(0..n, position, displacement, &keep, &mut seen, pairs);
+            self.seen = seen;
+            return;
+        }
+        let (mut seen, mut lanes) = (
+            std::mem::take(&mut self.seen),
+            std::mem::take(&mut self.lanes),
+        );
+        lanes.resize_with(threads - 1, QueryLane::default);
+        for (t, lane) in lanes.iter_mut().enumerate() {
+            lane.points = n * (t + 1) / threads..n * (t + 2) / threads;
+            lane.seen.clear();
+            lane.seen.resize(self.edge_boxes.len(), 0);
+            lane.pairs.clear();
+        }
+        let (this, keep) = (&*self, &keep);
+        std::thread::scope(|scope| {
+            for lane in lanes.iter_mut() {
+                scope.spawn(move || {
+                    let QueryLane {
+                        points,
+                        seen,
+                        pairs,
+                    } = lane;
+                    this.query_points(points.clone(), position, displacement, keep, seen, pairs);
+                });
+            }
+            this.query_points(
+                0..n / threads,
+                position,
+                displacement,
+                keep,
+                &mut seen,
+                pairs,
+            );
+        });
+        for lane in &lanes {
+            pairs.extend_from_slice(&lane.pairs);
+        }
+        self.seen = seen;
+        self.lanes = lanes;
+    }
+
+    /// The grid queries of the points in `points`, stamped in `seen`.
+    fn query_points(
+        &self,
+        points: std::ops::Range<usize>,
+        position: &[DVec2],
+        displacement: &[DVec2],
+        keep: &(impl Fn(u32, u32) -> bool + Sync),
+        seen: &mut [u32],
+        pairs: &mut Vec<(u32, u32)>,
+    ) {
+        for i in points {
+            let query = Aabb::swept(&[position[i], position[i] + displacement[i]], 0.0);
+            let point = i as u32;
+            let cells = self.cells(&query);
+            self.visit_cells(&query, cells, seen, point + 1, |k| {
+                if keep(point, k) {
+                    pairs.push((point, k));
+                }
+            });
         }
     }
 
@@ -322,11 +391,13 @@ impl BroadPhase {
         pairs: &mut Vec<(u32, u32)>,
     ) {
         self.reset_seen();
+        let mut seen = std::mem::take(&mut self.seen);
         for j in 0..self.edge_boxes.len() as u32 {
             let query = self.edge_boxes[j as usize];
             match method {
                 BroadPhaseMethod::Grid => {
-                    self.visit_cells(&query, self.edge_cells[j as usize], j + 1, |k| {
+                    let cells = self.edge_cells[j as usize];
+                    self.visit_cells(&query, cells, &mut seen, j + 1, |k| {
                         if k > j && keep(j, k) {
                             pairs.push((j, k));
                         }
@@ -341,6 +412,7 @@ impl BroadPhase {
                 }
             }
         }
+        self.seen = seen;
     }
 }
 
@@ -410,6 +482,7 @@ mod tests {
             let (mut grid, mut brute) = (Vec::new(), Vec::new());
             broad.point_edge_pairs(
                 BroadPhaseMethod::Grid,
+                1,
                 &position,
                 &displacement,
                 keep,
@@ -417,6 +490,7 @@ mod tests {
             );
             broad.point_edge_pairs(
                 BroadPhaseMethod::BruteForce,
+                1,
                 &position,
                 &displacement,
                 keep,

@@ -33,6 +33,9 @@ pub struct ImpulseSettings {
     pub separation: f64,
     /// How candidate pairs are found.
     pub broad_phase: BroadPhaseMethod,
+    /// Threads the candidate search may use (the pairs are the same, in the same
+    /// order, whatever the count).
+    pub threads: usize,
 }
 
 /// A contact met this step: point `p` against edge `edge` at `alpha`, along `normal`.
@@ -178,6 +181,7 @@ impl Collider<'_> {
         };
         scratch.broad.point_edge_pairs(
             self.settings.broad_phase,
+            self.settings.threads,
             self.position,
             &scratch.displacement,
             keep,

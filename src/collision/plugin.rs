@@ -46,9 +46,10 @@ impl Plugin for CollisionPlugin {
 }
 
 impl CollisionConfig {
-    /// The settings of the impulse passes.
-    pub fn impulse_settings(&self) -> ImpulseSettings {
+    /// The settings of one step's impulses, with `threads` for the candidate search.
+    pub fn impulse_settings(&self, threads: usize) -> ImpulseSettings {
         ImpulseSettings {
+            threads,
             thickness: self.thickness,
             friction: self.friction,
             restitution: self.restitution,
@@ -104,7 +105,7 @@ pub fn proximity(
     }
     let scratch = &mut *scratch;
     scratch.impulses.begin_step(state.len());
-    let settings = config.impulse_settings();
+    let settings = config.impulse_settings(step.worker_threads());
     let mut collider = collider(
         &mut state,
         &topology,
@@ -133,7 +134,7 @@ pub fn impulses(
         return;
     }
     let scratch = &mut *scratch;
-    let settings = config.impulse_settings();
+    let settings = config.impulse_settings(step.worker_threads());
     let mut collider = collider(
         &mut state,
         &topology,
