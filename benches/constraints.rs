@@ -22,7 +22,9 @@ use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
 use bevy_strands::metrics::IterationStats;
 use bevy_strands::model::Edge;
 use bevy_strands::prelude::*;
-use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{
+    BatchSize, Bencher, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main,
+};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
@@ -108,6 +110,22 @@ fn pile(strands: usize, particles: usize, rng: &mut StdRng) -> Pile {
     pile
 }
 
+/// Time `stage` on velocities reset to `initial` before each run (the reset untimed).
+fn bench_from(b: &mut Bencher, initial: &[DVec2], mut stage: impl FnMut(&mut [DVec2])) {
+    let mut velocity = initial.to_vec();
+    b.iter_custom(|iters| {
+        let mut total = Duration::ZERO;
+        for _ in 0..iters {
+            velocity.copy_from_slice(initial);
+            let start = Instant::now();
+            stage(&mut velocity);
+            total += start.elapsed();
+        }
+        black_box(&velocity);
+        total
+    })
+}
+
 fn constraint_stage(c: &mut Criterion) {
     let mut group = c.benchmark_group("constraint_stage");
     let mut rng = StdRng::seed_from_u64(2);
@@ -120,30 +138,22 @@ fn constraint_stage(c: &mut Criterion) {
     let dt = 1.0 / 3000.0;
     group.throughput(Throughput::Elements((strands * particles) as u64));
     group.bench_function(BenchmarkId::new("1000x100", "end_of_step"), |b| {
-        let mut velocity = pile.velocity.clone();
-        b.iter_custom(|iters| {
-            let mut total = Duration::ZERO;
-            for _ in 0..iters {
-                velocity.copy_from_slice(&pile.velocity);
-                let start = Instant::now();
-                for range in &pile.chains {
-                    let chain = Chain {
-                        edges: &pile.edges[range.clone()],
-                        closed: false,
-                    };
-                    let bodies = Bodies::new(&pile.position, &mut velocity, &pile.inverse_mass);
-                    black_box(project_chain(
-                        chain,
-                        bodies,
-                        &[],
-                        dt,
-                        &settings,
-                        &mut scratch,
-                    ));
-                }
-                total += start.elapsed();
+        bench_from(b, &pile.velocity, |velocity| {
+            for range in &pile.chains {
+                let chain = Chain {
+                    edges: &pile.edges[range.clone()],
+                    closed: false,
+                };
+                let bodies = Bodies::new(&pile.position, velocity, &pile.inverse_mass);
+                black_box(project_chain(
+                    chain,
+                    bodies,
+                    &[],
+                    dt,
+                    &settings,
+                    &mut scratch,
+                ));
             }
-            total
         })
     });
     // The same stage through the plugin's islands, on one thread and on two.
@@ -156,18 +166,9 @@ fn constraint_stage(c: &mut Criterion) {
     let mut stats = IterationStats::default();
     for threads in [1, 2] {
         group.bench_function(BenchmarkId::new("1000x100/islands", threads), |b| {
-            let mut velocity = pile.velocity.clone();
-            b.iter_custom(|iters| {
-                let mut total = Duration::ZERO;
-                for _ in 0..iters {
-                    velocity.copy_from_slice(&pile.velocity);
-                    let start = Instant::now();
-                    let mut bodies = Bodies::new(&pile.position, &mut velocity, &pile.inverse_mass);
-                    islands.project(&mut bodies, dt, &settings, &mut stats, threads);
-                    total += start.elapsed();
-                }
-                black_box(&velocity);
-                total
+            bench_from(b, &pile.velocity, |velocity| {
+                let mut bodies = Bodies::new(&pile.position, velocity, &pile.inverse_mass);
+                islands.project(&mut bodies, dt, &settings, &mut stats, threads);
             })
         });
     }
