@@ -94,6 +94,19 @@ pub enum RunError {
         /// What is wrong.
         source: SnapshotError,
     },
+    /// The state went non-finite: the run stops there rather than report it.
+    #[error(
+        "the state went non-finite in step {step} (t = {time} s): {what}; the run stops \
+         (is a step, a force or a velocity far too large for the scene?)"
+    )]
+    NonFinite {
+        /// The step that made it (1-based: the steps taken when it was found).
+        step: u64,
+        /// Simulated time at the end of the tick it was found in, in seconds.
+        time: String,
+        /// The particle and the value.
+        what: String,
+    },
     /// No built-in scenario has that name.
     #[error("unknown scenario '{name}'; valid scenarios: {valid}")]
     UnknownScenario {
@@ -268,6 +281,19 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         let tick_start = Instant::now();
         world.run_schedule(StrandsTick);
         wall_seconds += tick_start.elapsed().as_secs_f64();
+        if let Some(what) = first_non_finite(world) {
+            let clock = world.resource::<SimulationClock>();
+            let time = if clock.time.abs() < 1e6 {
+                format!("{:.6}", clock.time)
+            } else {
+                format!("{:e}", clock.time)
+            };
+            return Err(RunError::NonFinite {
+                step: clock.steps,
+                time,
+                what,
+            });
+        }
         particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
         progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
         if let Some(recorder) = &mut recorder {
@@ -329,6 +355,28 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         report.pictures.push(format!("plot: {}", path.display()));
     }
     Ok(report)
+}
+
+/// The first particle whose position or velocity is not finite, named by its strand
+/// and its place in it.
+fn first_non_finite(world: &World) -> Option<String> {
+    let state = world.resource::<ParticleState>();
+    let k = (0..state.len())
+        .find(|&k| !(state.position[k].is_finite() && state.velocity[k].is_finite()))?;
+    let (name, value) = if state.position[k].is_finite() {
+        ("velocity", state.velocity[k])
+    } else {
+        ("position", state.position[k])
+    };
+    let entity = state.entity[k];
+    let topology = world.resource::<Topology>();
+    let place = world.get::<StrandOf>(entity).and_then(|of| {
+        let strand = topology.strands.iter().position(|r| r.entity == of.0)?;
+        let index = (world.get::<Strand>(of.0)?.particles.iter()).position(|&p| p == entity)?;
+        Some(format!("strand {strand}, particle {index}"))
+    });
+    let place = place.unwrap_or_else(|| format!("particle {k} (in no strand)"));
+    Some(format!("{place} has {name} ({}, {})", value.x, value.y))
 }
 
 fn report(

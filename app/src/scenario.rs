@@ -347,6 +347,15 @@ impl Scenario {
         }
         positive("duration", self.duration).map_err(number(""))?;
         self.step.validate().map_err(number("step"))?;
+        if self.step.dt > self.duration {
+            return Err(fail(
+                "step.dt",
+                format!(
+                    "{:e} s is longer than the run ({:e} s): not one whole step fits",
+                    self.step.dt, self.duration
+                ),
+            ));
+        }
         self.constraints.validate().map_err(number("constraints"))?;
         self.collisions.validate().map_err(number("collisions"))?;
         self.contact.validate().map_err(number("contact"))?;

@@ -189,3 +189,36 @@ fn a_missing_file_is_reported_by_name() {
         "{message}"
     );
 }
+
+#[test]
+fn a_step_longer_than_the_run_is_rejected() {
+    let message = rejected(&GOOD.replace("dt: 0.001", "dt: 2.0"));
+    assert!(
+        message.contains("step.dt: 2e0 s is longer than the run (1e0 s)"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_state_gone_non_finite_stops_the_run_with_an_error() {
+    // Steps of 1e300 s: the first overflows the velocities, the next the positions.
+    let scene = GOOD
+        .replace("duration: 1.0", "duration: 4e300")
+        .replace("dt: 0.001, substeps: 10", "dt: 1e300, substeps: 1");
+    let dir = std::env::temp_dir().join(format!("bevy_strands_nonfinite_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("huge_step.ron");
+    std::fs::write(&file, scene).unwrap();
+    let options = RunOptions {
+        scene_file: Some(file),
+        check_crossings: true,
+        ..Default::default()
+    };
+    match bevy_strands_app::runner::run(&options, |_| {}) {
+        Err(RunError::NonFinite { step, what, .. }) => {
+            assert!(step <= 4, "found late: step {step}");
+            assert!(what.contains("strand 0, particle 0"), "{what}");
+        }
+        other => panic!("a non-finite state was not refused: {other:?}"),
+    }
+}
