@@ -102,6 +102,18 @@ pub struct Scenario {
     /// `container`).
     #[serde(default)]
     pub scale: Option<ScaleSpec>,
+    /// The most particles the scene may start with: a larger scene is refused rather
+    /// than allocated (a typo of a few zeros would otherwise fill the memory).
+    #[serde(default = "default_max_particles")]
+    pub max_particles: usize,
+}
+
+/// [`Scenario::max_particles`] unless a scene says otherwise: 4 million particles
+/// (about 1 GiB of state and solver buffers).
+pub const DEFAULT_MAX_PARTICLES: usize = 4_000_000;
+
+fn default_max_particles() -> usize {
+    DEFAULT_MAX_PARTICLES
 }
 
 /// Many straight strands in rows, dropped into a box sized to hold them (the scale and
@@ -338,6 +350,19 @@ impl Scenario {
         }
     }
 
+    /// Particles spawned at the start (factories add theirs later), counted without
+    /// overflow.
+    pub fn initial_particles(&self) -> usize {
+        let strands = self.strands.iter().map(|s| match &s.shape {
+            ShapeSpec::Line { particles, .. } => *particles,
+            ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => points.len(),
+        });
+        let scale = self.scale.map(|s| s.strands.saturating_mul(s.particles));
+        let fur =
+            (self.furry_creature.as_ref()).map(|f| f.hairs.saturating_mul(f.particles_per_hair));
+        (strands.chain(scale).chain(fur)).fold(self.particles.len(), usize::saturating_add)
+    }
+
     /// Check every number and every item; the first problem found is returned.
     pub fn validate(&self, file: &str) -> Result<(), ScenarioError> {
         let fail = |item: &str, problem: String| ScenarioError::new(file, item, problem);
@@ -346,6 +371,17 @@ impl Scenario {
             return Err(fail("name", "must not be empty".into()));
         }
         positive("duration", self.duration).map_err(number(""))?;
+        let particles = self.initial_particles();
+        if particles > self.max_particles {
+            return Err(fail(
+                "max_particles",
+                format!(
+                    "the scene starts with {particles} particles, more than {} (raise \
+                     max_particles to allow it)",
+                    self.max_particles
+                ),
+            ));
+        }
         self.step.validate().map_err(number("step"))?;
         if self.step.dt > self.duration {
             return Err(fail(

@@ -222,3 +222,19 @@ fn a_state_gone_non_finite_stops_the_run_with_an_error() {
         other => panic!("a non-finite state was not refused: {other:?}"),
     }
 }
+
+#[test]
+fn a_scene_larger_than_its_particle_cap_is_refused_before_anything_is_allocated() {
+    let message = rejected(&GOOD.replace("particles: 10,", "particles: 1000000000,"));
+    assert!(
+        message.contains(
+            "max_particles: the scene starts with 1000000004 particles, more than 4000000"
+        ),
+        "{message}"
+    );
+    // The cap is the scene's: lowered, the good scene's 14 particles are too many.
+    let lowered = GOOD.replace("duration: 1.0,", "duration: 1.0, max_particles: 13,");
+    assert!(rejected(&lowered).contains("starts with 14 particles, more than 13"));
+    let raised = GOOD.replace("duration: 1.0,", "duration: 1.0, max_particles: 14,");
+    assert!(Scenario::parse(&raised, "ok.ron").is_ok());
+}
