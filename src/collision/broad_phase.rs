@@ -79,8 +79,9 @@ pub struct BroadPhase {
     lanes: Vec<QueryLane>,
 }
 
-/// Below this many points the point queries stay on one thread.
-const PARALLEL_POINTS: usize = 16_384;
+/// Below this many queries (points, or edges for the crossing count) the queries stay
+/// on one thread: a query costs about half a microsecond, starting a thread tens.
+const PARALLEL_QUERIES: usize = 4096;
 
 /// One extra thread's share of the point queries: its points, its stamps, its pairs.
 #[derive(Clone, Debug, Default)]
@@ -315,7 +316,7 @@ impl BroadPhase {
             return;
         }
         let threads = threads.min(n);
-        if threads <= 1 || n < PARALLEL_POINTS {
+        if threads <= 1 || n < PARALLEL_QUERIES {
             let mut seen = std::mem::take(&mut self.seen);
             self.query_points(0..n, position, displacement, &keep, &mut seen, pairs);
             self.seen = seen;
@@ -380,6 +381,73 @@ impl BroadPhase {
                 }
             });
         }
+    }
+
+    /// Over every pair of edges (j < k) whose boxes overlap, in the order
+    /// [`BroadPhase::edge_edge_pairs`] gives them, how many `test` holds for, and the
+    /// first. With `threads` above one and enough edges, contiguous ranges of j are
+    /// tested on that many threads: the same count and the same first pair whatever the
+    /// count. Call [`BroadPhase::build`] first.
+    pub fn count_edge_pairs(
+        &mut self,
+        threads: usize,
+        test: impl Fn(u32, u32) -> bool + Sync,
+    ) -> (usize, Option<(u32, u32)>) {
+        self.reset_seen();
+        let n = self.edge_boxes.len();
+        let threads = threads.min(n);
+        let mut seen = std::mem::take(&mut self.seen);
+        if threads <= 1 || n < PARALLEL_QUERIES {
+            let found = self.count_edges(0..n, &test, &mut seen);
+            self.seen = seen;
+            return found;
+        }
+        let mut lanes = std::mem::take(&mut self.lanes);
+        lanes.resize_with(threads - 1, QueryLane::default);
+        for (t, lane) in lanes.iter_mut().enumerate() {
+            lane.points = n * (t + 1) / threads..n * (t + 2) / threads;
+            lane.seen.clear();
+            lane.seen.resize(n, 0);
+        }
+        let (this, test) = (&*self, &test);
+        let (first, rest) = std::thread::scope(|scope| {
+            let handles: Vec<_> = (lanes.iter_mut())
+                .map(|lane| {
+                    scope.spawn(move || this.count_edges(lane.points.clone(), test, &mut lane.seen))
+                })
+                .collect();
+            let first = this.count_edges(0..n / threads, test, &mut seen);
+            let rest: Vec<_> = (handles.into_iter())
+                .map(|h| h.join().expect("a crossing-count thread panicked"))
+                .collect();
+            (first, rest)
+        });
+        self.seen = seen;
+        self.lanes = lanes;
+        rest.into_iter()
+            .fold(first, |(count, found), (c, f)| (count + c, found.or(f)))
+    }
+
+    /// [`BroadPhase::count_edge_pairs`] over the edges `range` as the first of a pair.
+    fn count_edges(
+        &self,
+        range: std::ops::Range<usize>,
+        test: &(impl Fn(u32, u32) -> bool + Sync),
+        seen: &mut [u32],
+    ) -> (usize, Option<(u32, u32)>) {
+        let (mut count, mut first) = (0, None);
+        for j in range {
+            let j = j as u32;
+            let query = self.edge_boxes[j as usize];
+            let cells = self.edge_cells[j as usize];
+            self.visit_cells(&query, cells, seen, j + 1, |k| {
+                if k > j && test(j, k) {
+                    count += 1;
+                    first.get_or_insert((j, k));
+                }
+            });
+        }
+        (count, first)
     }
 
     /// Append every pair of edges (j < k) whose boxes overlap and for which `keep`
@@ -508,5 +576,22 @@ mod tests {
             assert_eq!(grid, brute, "{strands} strands, far {far}");
         }
         assert!(dense_seen, "a crowded scene is indexed directly");
+    }
+
+    #[test]
+    fn counting_edge_pairs_on_two_threads_matches_one_and_the_pair_list() {
+        let mut rng = StdRng::seed_from_u64(4);
+        let (position, displacement, edges) = random_scene(&mut rng, 1000);
+        assert!(edges.len() >= PARALLEL_QUERIES, "{} edges", edges.len());
+        let mut broad = BroadPhase::default();
+        broad.build(&edges, &position, Some(&displacement), 0.004);
+        let test = |j: u32, k: u32| (j + k).is_multiple_of(3);
+        let mut listed = Vec::new();
+        broad.edge_edge_pairs(BroadPhaseMethod::Grid, test, &mut listed);
+        let one = broad.count_edge_pairs(1, test);
+        assert!(one.0 > 1000, "{one:?}");
+        assert_eq!(one, (listed.len(), listed.first().copied()));
+        assert_eq!(broad.count_edge_pairs(2, test), one);
+        assert_eq!(broad.count_edge_pairs(3, test), one);
     }
 }

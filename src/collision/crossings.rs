@@ -19,33 +19,35 @@ pub struct Crossings {
     pub first: Option<(u32, u32)>,
 }
 
-/// Edge pairs that share no particle and intersect at `position`. `pairs` is scratch.
+/// Edge pairs that share no particle and intersect at `position`. `pairs` is scratch
+/// (brute force); the grid's pairs are tested on `threads` threads as they are found.
 pub fn count_crossings(
     edges: &[Edge],
     position: &[DVec2],
     broad: &mut BroadPhase,
     method: BroadPhaseMethod,
+    threads: usize,
     pairs: &mut Vec<(u32, u32)>,
 ) -> Crossings {
     broad.build(edges, position, None, 0.0);
-    pairs.clear();
-    broad.edge_edge_pairs(
-        method,
-        |j, k| !edges[j as usize].shares_particle(&edges[k as usize]),
-        pairs,
-    );
-    let mut crossings = Crossings::default();
-    for &(j, k) in pairs.iter() {
+    let crossed = |j: u32, k: u32| {
         let (e, f) = (&edges[j as usize], &edges[k as usize]);
-        if segments_intersect(
-            position[e.a as usize],
-            position[e.b as usize],
-            position[f.a as usize],
-            position[f.b as usize],
-        ) {
-            crossings.pairs += 1;
-            crossings.first.get_or_insert((j, k));
-        }
+        !e.shares_particle(f)
+            && segments_intersect(
+                position[e.a as usize],
+                position[e.b as usize],
+                position[f.a as usize],
+                position[f.b as usize],
+            )
+    };
+    if method == BroadPhaseMethod::Grid {
+        let (pairs, first) = broad.count_edge_pairs(threads, crossed);
+        return Crossings { pairs, first };
     }
-    crossings
+    pairs.clear();
+    broad.edge_edge_pairs(method, crossed, pairs);
+    Crossings {
+        pairs: pairs.len(),
+        first: pairs.first().copied(),
+    }
 }

@@ -191,6 +191,7 @@ pub fn account_collisions(
 /// recorded with its edges and logged as an error.
 pub fn check_crossings(
     config: Res<CollisionConfig>,
+    step: Res<StrandsConfig>,
     topology: Res<Topology>,
     state: Res<ParticleState>,
     clock: Res<SimulationClock>,
@@ -210,6 +211,7 @@ pub fn check_crossings(
         &state.position,
         crossing_broad,
         config.broad_phase,
+        step.worker_threads(),
         crossing_pairs,
     );
     metrics.crossing_pairs_last_step = crossings.pairs;
