@@ -83,10 +83,11 @@ pub struct BroadPhase {
 /// on one thread: a query costs about half a microsecond, starting a thread tens.
 const PARALLEL_QUERIES: usize = 4096;
 
-/// One extra thread's share of the point queries: its points, its stamps, its pairs.
+/// One extra thread's share of the broad phase's queries: its range, its stamps, its
+/// pairs.
 #[derive(Clone, Debug, Default)]
 struct QueryLane {
-    points: std::ops::Range<usize>,
+    range: std::ops::Range<usize>,
     seen: Vec<u32>,
     pairs: Vec<(u32, u32)>,
 }
@@ -315,50 +316,67 @@ impl BroadPhase {
             }
             return;
         }
-        let threads = threads.min(n);
-        if threads <= 1 || n < PARALLEL_QUERIES {
-            let mut seen = std::mem::take(&mut self.seen);
-            self.query_points(0..n, position, displacement, &keep, &mut seen, pairs);
-            self.seen = seen;
-            return;
-        }
-        let (mut seen, mut lanes) = (
-            std::mem::take(&mut self.seen),
-            std::mem::take(&mut self.lanes),
+        self.in_shares(
+            n,
+            threads,
+            pairs,
+            |this, points, seen, pairs| {
+                this.query_points(points, position, displacement, &keep, seen, pairs)
+            },
+            |(), ()| (),
         );
+    }
+
+    /// Run `work` over `0..n` in contiguous shares, each stamping its own `seen` and
+    /// appending to its own pairs: on one share into `pairs` below [`PARALLEL_QUERIES`]
+    /// or with one thread; else the first share on this thread into `pairs`, the others
+    /// on scoped threads into their lanes, appended to `pairs` in order after. The
+    /// shares' results are folded in order with `combine`: nothing depends on `threads`.
+    fn in_shares<R: Send>(
+        &mut self,
+        n: usize,
+        threads: usize,
+        pairs: &mut Vec<(u32, u32)>,
+        work: impl Fn(&Self, std::ops::Range<usize>, &mut [u32], &mut Vec<(u32, u32)>) -> R + Sync,
+        combine: impl Fn(R, R) -> R,
+    ) -> R {
+        let threads = threads.min(n);
+        let mut seen = std::mem::take(&mut self.seen);
+        if threads <= 1 || n < PARALLEL_QUERIES {
+            let result = work(self, 0..n, &mut seen, pairs);
+            self.seen = seen;
+            return result;
+        }
+        let mut lanes = std::mem::take(&mut self.lanes);
         lanes.resize_with(threads - 1, QueryLane::default);
         for (t, lane) in lanes.iter_mut().enumerate() {
-            lane.points = n * (t + 1) / threads..n * (t + 2) / threads;
+            lane.range = n * (t + 1) / threads..n * (t + 2) / threads;
             lane.seen.clear();
             lane.seen.resize(self.edge_boxes.len(), 0);
             lane.pairs.clear();
         }
-        let (this, keep) = (&*self, &keep);
-        std::thread::scope(|scope| {
-            for lane in lanes.iter_mut() {
-                scope.spawn(move || {
-                    let QueryLane {
-                        points,
-                        seen,
-                        pairs,
-                    } = lane;
-                    this.query_points(points.clone(), position, displacement, keep, seen, pairs);
-                });
-            }
-            this.query_points(
-                0..n / threads,
-                position,
-                displacement,
-                keep,
-                &mut seen,
-                pairs,
-            );
+        let (this, work) = (&*self, &work);
+        let (first, rest) = std::thread::scope(|scope| {
+            let handles: Vec<_> = (lanes.iter_mut())
+                .map(|lane| {
+                    scope.spawn(move || {
+                        let QueryLane { range, seen, pairs } = lane;
+                        work(this, range.clone(), seen, pairs)
+                    })
+                })
+                .collect();
+            let first = work(this, 0..n / threads, &mut seen, pairs);
+            let rest: Vec<R> = (handles.into_iter())
+                .map(|h| h.join().expect("a broad-phase thread panicked"))
+                .collect();
+            (first, rest)
         });
         for lane in &lanes {
             pairs.extend_from_slice(&lane.pairs);
         }
         self.seen = seen;
         self.lanes = lanes;
+        rest.into_iter().fold(first, combine)
     }
 
     /// The grid queries of the points in `points`, stamped in `seen`.
@@ -395,37 +413,15 @@ impl BroadPhase {
     ) -> (usize, Option<(u32, u32)>) {
         self.reset_seen();
         let n = self.edge_boxes.len();
-        let threads = threads.min(n);
-        let mut seen = std::mem::take(&mut self.seen);
-        if threads <= 1 || n < PARALLEL_QUERIES {
-            let found = self.count_edges(0..n, &test, &mut seen);
-            self.seen = seen;
-            return found;
-        }
-        let mut lanes = std::mem::take(&mut self.lanes);
-        lanes.resize_with(threads - 1, QueryLane::default);
-        for (t, lane) in lanes.iter_mut().enumerate() {
-            lane.points = n * (t + 1) / threads..n * (t + 2) / threads;
-            lane.seen.clear();
-            lane.seen.resize(n, 0);
-        }
-        let (this, test) = (&*self, &test);
-        let (first, rest) = std::thread::scope(|scope| {
-            let handles: Vec<_> = (lanes.iter_mut())
-                .map(|lane| {
-                    scope.spawn(move || this.count_edges(lane.points.clone(), test, &mut lane.seen))
-                })
-                .collect();
-            let first = this.count_edges(0..n / threads, test, &mut seen);
-            let rest: Vec<_> = (handles.into_iter())
-                .map(|h| h.join().expect("a crossing-count thread panicked"))
-                .collect();
-            (first, rest)
-        });
-        self.seen = seen;
-        self.lanes = lanes;
-        rest.into_iter()
-            .fold(first, |(count, found), (c, f)| (count + c, found.or(f)))
+        // Counted as found: the shares' pair lists stay empty.
+        let mut none = Vec::new();
+        self.in_shares(
+            n,
+            threads,
+            &mut none,
+            |this, range, seen, _| this.count_edges(range, &test, seen),
+            |(count, found), (c, f)| (count + c, found.or(f)),
+        )
     }
 
     /// [`BroadPhase::count_edge_pairs`] over the edges `range` as the first of a pair.
