@@ -38,6 +38,7 @@ pub mod collision;
 pub mod constraints;
 pub mod contact_loop;
 pub mod forces;
+pub mod guard;
 pub mod integrate;
 pub mod metrics;
 pub mod model;
@@ -70,6 +71,7 @@ use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_
 pub mod prelude {
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
+    pub use crate::guard::{FiniteGuard, NonFiniteState};
     pub use crate::metrics::StrandMetrics;
     pub use crate::schedule::{CollideSet, StepSet, StrandsStep, StrandsTick, TickSet};
     pub use crate::world::builder::StrandBuilder;
@@ -78,7 +80,7 @@ pub mod prelude {
         CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig,
     };
     pub use crate::world::particle::{
-        ExternalForce, Mass, Particle, Pinned, Position, Tether, Velocity,
+        ExternalForce, Frozen, Mass, Particle, Pinned, Position, Tether, Velocity,
     };
     pub use crate::world::problems::InputProblems;
     pub use crate::world::state::ParticleState;
@@ -174,5 +176,6 @@ impl Plugin for StrandsCorePlugin {
                     write_back.in_set(TickSet::Writeback),
                 ),
             );
+        guard::add_guard(app);
     }
 }

@@ -96,14 +96,16 @@ pub enum RunError {
     },
     /// The state went non-finite: the run stops there rather than report it.
     #[error(
-        "the state went non-finite in step {step} (t = {time} s): {what}; the run stops \
-         (is a step, a force or a velocity far too large for the scene?)"
+        "the state went non-finite in step {step} (t = {time} s), {stage} stage: {what}; \
+         the run stops (is a step, a force or a velocity far too large for the scene?)"
     )]
     NonFinite {
-        /// The step that made it (1-based: the steps taken when it was found).
+        /// The step that made it (1-based: the steps taken once it ends).
         step: u64,
-        /// Simulated time at the end of the tick it was found in, in seconds.
+        /// Simulated time at the start of that step, in seconds.
         time: String,
+        /// The stage of the step that made it.
+        stage: String,
         /// The particle and the value.
         what: String,
     },
@@ -281,18 +283,8 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         let tick_start = Instant::now();
         world.run_schedule(StrandsTick);
         wall_seconds += tick_start.elapsed().as_secs_f64();
-        if let Some(what) = first_non_finite(world) {
-            let clock = world.resource::<SimulationClock>();
-            let time = if clock.time.abs() < 1e6 {
-                format!("{:.6}", clock.time)
-            } else {
-                format!("{:e}", clock.time)
-            };
-            return Err(RunError::NonFinite {
-                step: clock.steps,
-                time,
-                what,
-            });
+        if let Some(event) = world.resource::<FiniteGuard>().events.first() {
+            return Err(non_finite_error(world, event));
         }
         particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
         progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
@@ -357,26 +349,41 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
     Ok(report)
 }
 
-/// The first particle whose position or velocity is not finite, named by its strand
-/// and its place in it.
-fn first_non_finite(world: &World) -> Option<String> {
-    let state = world.resource::<ParticleState>();
-    let k = (0..state.len())
-        .find(|&k| !(state.position[k].is_finite() && state.velocity[k].is_finite()))?;
-    let (name, value) = if state.position[k].is_finite() {
-        ("velocity", state.velocity[k])
-    } else {
-        ("position", state.position[k])
-    };
-    let entity = state.entity[k];
+/// The guard's first event as the runner's error, the particle named by its strand and
+/// its place in it.
+fn non_finite_error(world: &World, event: &NonFiniteState) -> RunError {
+    let entity = event.particle;
     let topology = world.resource::<Topology>();
-    let place = world.get::<StrandOf>(entity).and_then(|of| {
-        let strand = topology.strands.iter().position(|r| r.entity == of.0)?;
-        let index = (world.get::<Strand>(of.0)?.particles.iter()).position(|&p| p == entity)?;
+    let place = event.strand.and_then(|of| {
+        let strand = topology.strands.iter().position(|r| r.entity == of)?;
+        let index = (world.get::<Strand>(of)?.particles.iter()).position(|&p| p == entity)?;
         Some(format!("strand {strand}, particle {index}"))
     });
-    let place = place.unwrap_or_else(|| format!("particle {k} (in no strand)"));
-    Some(format!("{place} has {name} ({}, {})", value.x, value.y))
+    let place = place.unwrap_or_else(|| format!("particle {entity} (in no strand)"));
+    // Values this far out print as thousands of digits otherwise.
+    let number = |x: f64| {
+        if x.abs() < 1e6 {
+            format!("{x}")
+        } else {
+            format!("{x:e}")
+        }
+    };
+    let time = if event.time.abs() < 1e6 {
+        format!("{:.6}", event.time)
+    } else {
+        number(event.time)
+    };
+    RunError::NonFinite {
+        step: event.step,
+        time,
+        stage: format!("{:?}", event.stage),
+        what: format!(
+            "{place} has {} ({}, {})",
+            event.quantity.name(),
+            number(event.value.x),
+            number(event.value.y)
+        ),
+    }
 }
 
 fn report(

@@ -54,6 +54,13 @@ impl Default for Mass {
 #[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
 pub struct Pinned;
 
+/// A particle held where the finiteness guard froze it (a non-finite value appeared in
+/// its island): simulated as pinned with zero velocity until the marker is removed.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default)]
+#[reflect(Component)]
+#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+pub struct Frozen;
+
 /// A constant force applied to the particle each step, on top of gravity.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 #[reflect(Component)]

@@ -7,7 +7,9 @@ use bevy::prelude::*;
 
 use crate::model::validate::check_particle;
 use crate::world::hooks::TopologyDirty;
-use crate::world::particle::{ExternalForce, Mass, Particle, Position, SolverIndex, Velocity};
+use crate::world::particle::{
+    ExternalForce, Frozen, Mass, Particle, Position, SolverIndex, Velocity,
+};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::topology::Topology;
@@ -22,6 +24,7 @@ type GatherQuery<'w, 's> = Query<
         &'static Velocity,
         &'static Mass,
         Option<&'static ExternalForce>,
+        Has<Frozen>,
     ),
     With<Particle>,
 >;
@@ -34,7 +37,7 @@ pub fn gather(
     mut problems: ResMut<InputProblems>,
     particles: GatherQuery,
 ) {
-    for (entity, index, position, velocity, mass, external) in &particles {
+    for (entity, index, position, velocity, mass, external, frozen) in &particles {
         let Some(i) = index.get() else { continue };
         let pinned = topology.pinned[i];
         if let Err(problem) = check_particle(position.0, velocity.0, mass.0, pinned) {
@@ -44,7 +47,8 @@ pub fn gather(
             continue;
         }
         state.position[i] = position.0;
-        state.velocity[i] = velocity.0;
+        // A frozen particle stays where it is, whatever its velocity says.
+        state.velocity[i] = if frozen { DVec2::ZERO } else { velocity.0 };
         state.mass[i] = mass.0;
         state.inverse_mass[i] = if pinned { 0.0 } else { 1.0 / mass.0 };
         state.external_force[i] = match external {

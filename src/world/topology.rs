@@ -17,7 +17,7 @@ use crate::model::validate::{StrandError, check_particle, check_strand_shape};
 use crate::model::{Bend, Edge, NO_ISLAND, bend_count};
 use crate::world::config::StrandsConfig;
 use crate::world::hooks::TopologyDirty;
-use crate::world::particle::{Mass, Particle, Pinned, Position, SolverIndex, Velocity};
+use crate::world::particle::{Frozen, Mass, Particle, Pinned, Position, SolverIndex, Velocity};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
@@ -91,11 +91,18 @@ pub fn rebuild_topology(world: &mut World) {
     let default_material = world.resource::<StrandsConfig>().material;
     let mut problems = world.remove_resource::<InputProblems>().unwrap_or_default();
 
-    // Particles that can be simulated, and whether each is pinned.
-    let mut particles = world
-        .query_filtered::<(Entity, &Position, &Velocity, &Mass, Has<Pinned>), With<Particle>>();
+    // Particles that can be simulated, and whether each is pinned (a frozen one is).
+    let mut particles = world.query_filtered::<(
+        Entity,
+        &Position,
+        &Velocity,
+        &Mass,
+        Has<Pinned>,
+        Has<Frozen>,
+    ), With<Particle>>();
     let mut valid: EntityHashMap<bool> = EntityHashMap::default();
-    for (entity, position, velocity, mass, pinned) in particles.iter(world) {
+    for (entity, position, velocity, mass, pinned, frozen) in particles.iter(world) {
+        let pinned = pinned || frozen;
         match check_particle(position.0, velocity.0, mass.0, pinned) {
             Err(problem) => problems.report(entity, format!("particle left out: {problem}")),
             Ok(()) => {

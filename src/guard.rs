@@ -1,0 +1,312 @@
+//! The finiteness guard: a non-finite force, velocity or position is caught after the
+//! stage that made it, and the constraint island it appeared in is frozen at its last
+//! finite state instead of spreading NaN to everything it touches.
+//!
+//! After each stage of a step one array is scanned — the one that stage writes:
+//! forces after Forces, velocities after Predict, Constrain and Collide, positions after
+//! Integrate. At the first non-finite value the island of every bad particle (the whole
+//! solved island, or the particle alone if it is in none) goes back to where it was at
+//! the start of the step, with zero velocity, and stays there for the rest of the tick;
+//! at the end of the tick its particles get the [`Frozen`] marker, which the topology
+//! treats as a pin with zero velocity. A [`NonFiniteState`] message says where, when and
+//! in which stage, and [`FiniteGuard::events`] keeps the same record for code that does
+//! not read messages (the runner stops on it). Removing [`Frozen`] lets the island move
+//! again.
+
+use bevy::ecs::system::SystemParam;
+use bevy::math::DVec2;
+use bevy::prelude::*;
+
+use crate::model::NO_ISLAND;
+use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet};
+use crate::world::clock::SimulationClock;
+use crate::world::config::StrandsConfig;
+use crate::world::particle::{Frozen, Position, SolverIndex};
+use crate::world::state::ParticleState;
+use crate::world::strand::StrandOf;
+use crate::world::topology::Topology;
+
+/// Which quantity went non-finite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// The force accumulated in the Forces stage.
+    Force,
+    /// The velocity.
+    Velocity,
+    /// The position.
+    Position,
+}
+
+impl Quantity {
+    /// Its name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Force => "force",
+            Quantity::Velocity => "velocity",
+            Quantity::Position => "position",
+        }
+    }
+}
+
+/// A non-finite value caught by the guard, and what was frozen because of it.
+#[derive(Message, Clone, Debug, PartialEq)]
+pub struct NonFiniteState {
+    /// The step it appeared in (1-based: the steps taken once this one ends).
+    pub step: u64,
+    /// Simulated time at the start of that step, in seconds.
+    pub time: f64,
+    /// The stage that produced it.
+    pub stage: StepSet,
+    /// The first particle (in packed order) with a non-finite value.
+    pub particle: Entity,
+    /// Its strand, if it belongs to one.
+    pub strand: Option<Entity>,
+    /// The quantity and its value.
+    pub quantity: Quantity,
+    /// The value.
+    pub value: DVec2,
+    /// How many particles had a non-finite value.
+    pub bad_particles: usize,
+    /// How many particles were frozen (the islands of the bad ones).
+    pub frozen_particles: usize,
+}
+
+/// The guard's state: the start of the current step, what this tick froze, and every
+/// event since start-up.
+#[derive(Resource, Default, Debug)]
+pub struct FiniteGuard {
+    /// Positions at the start of the current step.
+    start_position: Vec<DVec2>,
+    /// Packed indices held still and where: the particles marked [`Frozen`] when the
+    /// tick began, then those frozen during it. Re-applied after every stage, so a
+    /// frozen particle's force (an overflowing one among them) never reaches anything.
+    frozen: Vec<(u32, DVec2)>,
+    /// How many of `frozen` carry the marker already.
+    marked: usize,
+    /// Per packed particle, whether it is in `frozen`.
+    is_frozen: Vec<bool>,
+    /// Every event, in order.
+    pub events: Vec<NonFiniteState>,
+}
+
+/// Index of the first vector with a non-finite component. Scans in blocks whose test
+/// is a branch-free reduction, so the common all-finite case runs at memory speed.
+pub fn first_non_finite(values: &[DVec2]) -> Option<usize> {
+    const BLOCK: usize = 256;
+    values.chunks(BLOCK).enumerate().find_map(|(b, block)| {
+        let bad = block
+            .iter()
+            .fold(false, |bad, v| bad | !v.x.is_finite() | !v.y.is_finite());
+        bad.then(|| b * BLOCK + block.iter().position(|v| !v.is_finite()).unwrap_or(0))
+    })
+}
+
+/// Add the guard to a step schedule's stages and the tick's write-back.
+pub(crate) fn add_guard(app: &mut App) {
+    app.init_resource::<FiniteGuard>()
+        .add_message::<NonFiniteState>()
+        .register_type::<Frozen>();
+    let check = |stage: StepSet, quantity: Quantity| {
+        move |params: CheckParams| check_stage(stage, quantity, params)
+    };
+    app.add_systems(
+        StrandsStep,
+        (
+            begin_step.before(StepSet::Forces),
+            check(StepSet::Forces, Quantity::Force)
+                .after(StepSet::Forces)
+                .before(StepSet::Predict),
+            check(StepSet::Predict, Quantity::Velocity)
+                .after(StepSet::Predict)
+                .before(StepSet::Constrain),
+            check(StepSet::Constrain, Quantity::Velocity)
+                .after(StepSet::Constrain)
+                .before(StepSet::Collide),
+            check(StepSet::Collide, Quantity::Velocity)
+                .after(StepSet::Collide)
+                .before(StepSet::Integrate),
+            check(StepSet::Integrate, Quantity::Position)
+                .after(StepSet::Integrate)
+                .before(StepSet::Measure),
+        ),
+    );
+    app.add_systems(
+        StrandsTick,
+        (
+            collect_frozen.after(TickSet::Gather).before(TickSet::Step),
+            freeze_entities.after(TickSet::Writeback),
+        ),
+    );
+}
+
+/// The particles already frozen, once the tick's state is gathered.
+fn collect_frozen(
+    mut guard: ResMut<FiniteGuard>,
+    state: Res<ParticleState>,
+    frozen: Query<(&SolverIndex, &Position), With<Frozen>>,
+) {
+    let guard = &mut *guard;
+    guard.frozen.clear();
+    guard.is_frozen.clear();
+    guard.is_frozen.resize(state.len(), false);
+    for (index, position) in &frozen {
+        if let Some(i) = index.get() {
+            guard.is_frozen[i] = true;
+            guard.frozen.push((i as u32, position.0));
+        }
+    }
+    guard.marked = guard.frozen.len();
+}
+
+/// Remember where the step starts.
+fn begin_step(mut guard: ResMut<FiniteGuard>, state: Res<ParticleState>) {
+    guard.start_position.clear();
+    guard.start_position.extend_from_slice(&state.position);
+}
+
+/// What a check reads and writes.
+#[derive(SystemParam)]
+struct CheckParams<'w, 's> {
+    guard: ResMut<'w, FiniteGuard>,
+    state: ResMut<'w, ParticleState>,
+    topology: Res<'w, Topology>,
+    clock: Res<'w, SimulationClock>,
+    config: Res<'w, StrandsConfig>,
+    strands: Query<'w, 's, &'static StrandOf>,
+    messages: MessageWriter<'w, NonFiniteState>,
+}
+
+/// After `stage`: hold what this tick froze, then scan `quantity` and freeze the
+/// islands of any non-finite particle.
+fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
+    let CheckParams {
+        mut guard,
+        mut state,
+        topology,
+        clock,
+        config,
+        strands,
+        mut messages,
+    } = params;
+    let guard = &mut *guard;
+    let state = &mut *state;
+    hold_frozen(guard, state);
+    let values = match quantity {
+        Quantity::Force => &state.force,
+        Quantity::Velocity => &state.velocity,
+        Quantity::Position => &state.position,
+    };
+    let Some(first) = first_non_finite(values) else {
+        return;
+    };
+    let value = values[first];
+    let bad: Vec<usize> = (first..values.len())
+        .filter(|&i| !values[i].is_finite())
+        .collect();
+    let before = guard.frozen.len();
+    freeze_islands(guard, state, &topology, &bad);
+    hold_frozen(guard, state);
+    let particle = state.entity[first];
+    // The Integrate stage has already counted the step.
+    let step = clock.steps + u64::from(stage != StepSet::Integrate);
+    let event = NonFiniteState {
+        step,
+        time: (step - 1) as f64 * config.dt,
+        stage,
+        particle,
+        strand: strands.get(particle).ok().map(|of| of.0),
+        quantity,
+        value,
+        bad_particles: bad.len(),
+        frozen_particles: guard.frozen.len() - before,
+    };
+    error!(
+        "bevy_strands: step {step}, {stage:?} stage: particle {particle} has {} {value}; \
+         {} particles frozen",
+        quantity.name(),
+        event.frozen_particles
+    );
+    messages.write(event.clone());
+    guard.events.push(event);
+}
+
+/// Freeze the islands of the `bad` packed particles at the step's start.
+fn freeze_islands(
+    guard: &mut FiniteGuard,
+    state: &ParticleState,
+    topology: &Topology,
+    bad: &[usize],
+) {
+    let island_of = |i: usize| topology.island.get(i).copied().unwrap_or(NO_ISLAND);
+    let mut islands: Vec<u32> = bad
+        .iter()
+        .map(|&i| island_of(i))
+        .filter(|&k| k != NO_ISLAND)
+        .collect();
+    islands.sort_unstable();
+    islands.dedup();
+    let freeze = |i: usize, guard: &mut FiniteGuard| {
+        if !guard.is_frozen[i] {
+            guard.is_frozen[i] = true;
+            guard.frozen.push((i as u32, guard.start_position[i]));
+        }
+    };
+    for &i in bad {
+        freeze(i, guard);
+    }
+    if !islands.is_empty() {
+        for i in 0..state.len() {
+            if islands.binary_search(&island_of(i)).is_ok() {
+                freeze(i, guard);
+            }
+        }
+    }
+}
+
+/// Put every particle frozen this tick back where it was frozen, at rest.
+fn hold_frozen(guard: &FiniteGuard, state: &mut ParticleState) {
+    for &(i, at) in &guard.frozen {
+        let i = i as usize;
+        state.position[i] = at;
+        state.velocity[i] = DVec2::ZERO;
+        state.force[i] = DVec2::ZERO;
+    }
+}
+
+/// Mark the particles this tick froze, so the topology pins them from the next tick on.
+fn freeze_entities(
+    mut guard: ResMut<FiniteGuard>,
+    state: Res<ParticleState>,
+    mut commands: Commands,
+) {
+    for &(i, _) in &guard.frozen[guard.marked..] {
+        if let Some(&entity) = state.entity.get(i as usize) {
+            commands.entity(entity).insert(Frozen);
+        }
+    }
+    guard.marked = guard.frozen.len();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_non_finite_vector_is_found_in_any_block() {
+        let mut values = vec![DVec2::ONE; 1000];
+        assert_eq!(first_non_finite(&values), None);
+        for at in [0, 255, 256, 700, 999] {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                values[at] = DVec2::new(1.0, bad);
+                assert_eq!(first_non_finite(&values), Some(at));
+                values[at] = DVec2::new(bad, 1.0);
+                assert_eq!(first_non_finite(&values), Some(at));
+                values[at] = DVec2::ONE;
+            }
+        }
+        values[300] = DVec2::NAN;
+        values[900] = DVec2::NAN;
+        assert_eq!(first_non_finite(&values), Some(300));
+        assert_eq!(first_non_finite(&[]), None);
+    }
+}

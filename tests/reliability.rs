@@ -1,0 +1,123 @@
+//! Reliability inside a game: a non-finite value is caught in the stage that made it,
+//! its island is frozen at its last finite state, and everything else steps on as if it
+//! had not happened.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_strands::guard::Quantity;
+use bevy_strands::prelude::*;
+use bevy_strands_app::fixtures::*;
+
+/// Two ropes far apart; `poison` gives the first one's third particle a force that
+/// overflows once gravity is added to it.
+fn two_ropes(poison: bool) -> (App, Entity, Entity) {
+    let mut app = app();
+    set_step(&mut app, 1.0 / 600.0, 4);
+    let world = app.world_mut();
+    let bad = StrandBuilder::line(DVec2::new(0.1, 0.9), DVec2::X, 8, 0.02)
+        .pin_first()
+        .spawn_in(world)
+        .unwrap();
+    let good = StrandBuilder::line(DVec2::new(0.6, 0.9), DVec2::X, 8, 0.02)
+        .pin_first()
+        .spawn_in(world)
+        .unwrap();
+    if poison {
+        let third = strand_particles(&app, bad)[2];
+        // m g is finite and so is the external force; their sum is not.
+        app.world_mut()
+            .entity_mut(third)
+            .insert((Mass(1e300), ExternalForce(DVec2::new(0.0, -f64::MAX))));
+    }
+    (app, bad, good)
+}
+
+#[test]
+fn a_non_finite_force_freezes_its_island_and_nothing_else() {
+    let (mut clean, _, clean_good) = two_ropes(false);
+    let (mut app, bad, good) = two_ropes(true);
+    let start: Vec<DVec2> = strand_particles(&app, bad)
+        .iter()
+        .map(|&p| position(&app, p))
+        .collect();
+    ticks(&mut clean, 30);
+    ticks(&mut app, 30);
+
+    let events = &app.world().resource::<FiniteGuard>().events;
+    assert_eq!(events.len(), 1, "{events:?}");
+    let event = &events[0];
+    let third = strand_particles(&app, bad)[2];
+    assert_eq!((event.step, event.stage), (1, StepSet::Forces));
+    assert_eq!((event.particle, event.strand), (third, Some(bad)));
+    assert_eq!(event.quantity, Quantity::Force);
+    assert_eq!(event.value.y, f64::NEG_INFINITY);
+    // Its island: the rope but its pinned first particle, which never moves anyway.
+    assert_eq!((event.bad_particles, event.frozen_particles), (1, 7));
+
+    // The poisoned rope is held where the first step started, at rest, and marked.
+    for (k, (&p, &x)) in strand_particles(&app, bad).iter().zip(&start).enumerate() {
+        assert_eq!(position(&app, p), x);
+        assert_eq!(velocity(&app, p), DVec2::ZERO);
+        assert_eq!(app.world().get::<Frozen>(p).is_some(), k > 0);
+    }
+    // The other rope swings exactly as it does in a world without the poison.
+    for (&p, &q) in strand_particles(&app, good)
+        .iter()
+        .zip(&strand_particles(&clean, clean_good))
+    {
+        assert_eq!(position(&app, p), position(&clean, q));
+        assert_eq!(velocity(&app, p), velocity(&clean, q));
+        assert!(app.world().get::<Frozen>(p).is_none());
+    }
+    assert!(position(&app, strand_particles(&app, good)[7]).y < 0.85);
+
+    // The message was written too.
+    let messages = app.world().resource::<Messages<NonFiniteState>>();
+    assert_eq!(messages.iter_current_update_messages().count(), 1);
+}
+
+#[test]
+fn a_frozen_island_moves_again_once_the_marker_and_the_cause_are_removed() {
+    let (mut app, bad, _) = two_ropes(true);
+    ticks(&mut app, 3);
+    let particles = strand_particles(&app, bad);
+    app.world_mut()
+        .entity_mut(particles[2])
+        .remove::<ExternalForce>()
+        .insert(Mass(1.0));
+    for &p in &particles {
+        app.world_mut().entity_mut(p).remove::<Frozen>();
+    }
+    let tip = position(&app, particles[7]);
+    ticks(&mut app, 10);
+    assert!(position(&app, particles[7]).y < tip.y - 1e-3);
+    assert_eq!(app.world().resource::<FiniteGuard>().events.len(), 1);
+    // The first particle was pinned before and still is.
+    assert_eq!(position(&app, particles[0]), DVec2::new(0.1, 0.9));
+}
+
+#[test]
+fn a_velocity_that_overflows_in_the_predictor_is_caught_there() {
+    let mut app = app();
+    set_step(&mut app, 1e300, 1);
+    let p = app
+        .world_mut()
+        .spawn((
+            Particle,
+            Position(DVec2::new(0.5, 0.5)),
+            Velocity(DVec2::ZERO),
+        ))
+        .id();
+    // dt g overflows in the first prediction: v = 1e300 (-9.81).
+    app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::new(0.0, -1e10);
+    ticks(&mut app, 2);
+    let events = &app.world().resource::<FiniteGuard>().events;
+    assert_eq!(events.len(), 1);
+    assert_eq!(
+        (events[0].stage, events[0].quantity),
+        (StepSet::Predict, Quantity::Velocity)
+    );
+    assert_eq!(events[0].strand, None);
+    assert_eq!(position(&app, p), DVec2::new(0.5, 0.5));
+    assert!(app.world().get::<Frozen>(p).is_some());
+}
