@@ -512,11 +512,8 @@ impl Scenario {
         if self.links.is_empty() {
             return Ok(());
         }
-        let points: Vec<Vec<DVec2>> = self
-            .strands
-            .iter()
-            .map(|s| s.builder().points().to_vec())
-            .collect();
+        let builders: Vec<_> = self.strands.iter().map(|s| s.builder()).collect();
+        let points: Vec<&[DVec2]> = builders.iter().map(|b| b.points()).collect();
         let mut seen = std::collections::HashSet::new();
         for (i, link) in self.links.iter().enumerate() {
             let item = format!("links[{i}]");
@@ -556,6 +553,17 @@ impl Scenario {
                 ));
             }
             let key = (link.from.min(link.to), link.from.max(link.to));
+            let ((s, a), (t, b)) = key;
+            let n = points[s].len();
+            if s == t && (b - a == 1 || builders[s].is_closed() && (a, b) == (0, n - 1)) {
+                return Err((
+                    item,
+                    format!(
+                        "joins particles {a} and {b} of strand {s}, which an edge of that \
+                         strand already joins"
+                    ),
+                ));
+            }
             if !seen.insert(key) {
                 return Err((
                     item,

@@ -118,6 +118,29 @@ fn links_must_name_two_existing_separate_particles_once() {
         message.contains("links[0].from: strand 0 has no particle 10; it has 10"),
         "{message}"
     );
+    // Neighbours along a strand are joined by its own edge already.
+    let message = rejected(&with_links("(from: (0, 4), to: (0, 3))"));
+    assert!(
+        message.contains(
+            "links[0]: joins particles 3 and 4 of strand 0, which an edge of that strand \
+             already joins"
+        ),
+        "{message}"
+    );
+    assert!(Scenario::parse(&with_links("(from: (0, 2), to: (0, 4))"), "ok.ron").is_ok());
+    // A loop's last particle is joined to its first; an open strand's is not.
+    let looped = |links: &str| {
+        with_links(links).replace(
+            "Polyline(points: [(0.1, 0.2)",
+            "Polygon(points: [(0.1, 0.2)",
+        )
+    };
+    let message = rejected(&looped("(from: (1, 0), to: (1, 2))"));
+    assert!(
+        message.contains("joins particles 0 and 2 of strand 1"),
+        "{message}"
+    );
+    assert!(Scenario::parse(&with_links("(from: (1, 0), to: (1, 2))"), "ok.ron").is_ok());
     let message = rejected(&with_links("(from: (1, 2), to: (1, 2))"));
     assert!(
         message.contains("links[0]: an edge needs two different particles"),

@@ -148,6 +148,11 @@ impl StrandBuilder {
         &self.points
     }
 
+    /// Whether the strand is a loop (its last particle joined to its first).
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
     fn velocity_of(&self, i: usize) -> DVec2 {
         self.velocities.as_ref().map_or(self.velocity, |v| v[i])
     }
