@@ -13,6 +13,7 @@
 pub mod builtin;
 pub mod export;
 pub mod fixtures;
+pub mod initial_state;
 pub mod report;
 pub mod runner;
 pub mod scenario;

@@ -106,11 +106,17 @@ pub struct Scenario {
     /// than allocated (a typo of a few zeros would otherwise fill the memory).
     #[serde(default = "default_max_particles")]
     pub max_particles: usize,
+    /// Start even though strands cross, overlap within the thickness or leave the
+    /// container, for this reason (otherwise such a scene is refused).
+    #[serde(default)]
+    pub allow_initial_contact: Option<String>,
+    /// The file the scene was read from (empty for a built-in one or a snapshot's).
+    #[serde(skip)]
+    pub source: String,
 }
 
-/// [`Scenario::max_particles`] unless a scene says otherwise: 4 million particles
-/// (about 1 GiB of state and solver buffers).
-pub const DEFAULT_MAX_PARTICLES: usize = 4_000_000;
+/// [`Scenario::max_particles`] unless a scene says otherwise: the library's default cap.
+pub use bevy_strands::world::config::DEFAULT_MAX_PARTICLES;
 
 fn default_max_particles() -> usize {
     DEFAULT_MAX_PARTICLES
@@ -322,8 +328,19 @@ impl Scenario {
                 e.code.to_string(),
             )
         })?;
+        let mut scenario = scenario;
         scenario.validate(file)?;
+        scenario.source = file.to_string();
         Ok(scenario)
+    }
+
+    /// What messages about the scene name: its file, or its name if it has none.
+    pub fn origin(&self) -> &str {
+        if self.source.is_empty() {
+            &self.name
+        } else {
+            &self.source
+        }
     }
 
     /// Read, parse and validate a scenario file.
@@ -380,6 +397,16 @@ impl Scenario {
                      max_particles to allow it)",
                     self.max_particles
                 ),
+            ));
+        }
+        if self
+            .allow_initial_contact
+            .as_deref()
+            .is_some_and(|r| r.trim().is_empty())
+        {
+            return Err(fail(
+                "allow_initial_contact",
+                "give the reason the scene starts in contact, not an empty string".into(),
             ));
         }
         self.step.validate().map_err(number("step"))?;

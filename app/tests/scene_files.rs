@@ -2,7 +2,7 @@
 //! a message naming the file, the item and the problem.
 
 use bevy_strands_app::builtin::BUILTIN_SCENES;
-use bevy_strands_app::runner::{RunError, RunOptions, load_scenario};
+use bevy_strands_app::runner::{RunError, RunOptions, headless_app, load_scenario};
 use bevy_strands_app::scenario::Scenario;
 
 const GOOD: &str = r#"(
@@ -14,7 +14,7 @@ const GOOD: &str = r#"(
         (shape: Line(start: (0.1, 0.5), angle_degrees: 0.0, particles: 10, spacing: 0.05)),
         (shape: Polyline(points: [(0.1, 0.2), (0.2, 0.2), (0.3, 0.25)]), mass: 2.0),
     ],
-    particles: [(position: (0.5, 0.5))],
+    particles: [(position: (0.5, 0.7))],
 )"#;
 
 fn rejected(text: &str) -> String {
@@ -60,8 +60,8 @@ fn non_positive_masses_are_rejected() {
         "{message}"
     );
     let message = rejected(&GOOD.replace(
-        "(position: (0.5, 0.5))",
-        "(position: (0.5, 0.5), mass: 0.0)",
+        "(position: (0.5, 0.7))",
+        "(position: (0.5, 0.7), mass: 0.0)",
     ));
     assert!(message.contains("particles[0].mass"), "{message}");
 }
@@ -260,4 +260,79 @@ fn a_scene_larger_than_its_particle_cap_is_refused_before_anything_is_allocated(
     assert!(rejected(&lowered).contains("starts with 14 particles, more than 13"));
     let raised = GOOD.replace("duration: 1.0,", "duration: 1.0, max_particles: 14,");
     assert!(Scenario::parse(&raised, "ok.ron").is_ok());
+}
+
+/// The problem `headless_app` finds with the initial state of a scene that parses.
+fn refused_at_start(text: &str) -> String {
+    let scene = Scenario::parse(text, "start.ron").expect("the scene parses");
+    match headless_app(&scene) {
+        Ok(_) => panic!("the initial state was accepted:\n{text}"),
+        Err(RunError::Scenario(e)) => {
+            assert_eq!(
+                (e.file.as_str(), e.item.as_str()),
+                ("start.ron", "initial state")
+            );
+            e.problem
+        }
+        Err(e) => panic!("refused for another reason: {e}"),
+    }
+}
+
+#[test]
+fn an_initial_state_that_crosses_overlaps_or_leaves_the_container_is_refused() {
+    assert!(headless_app(&Scenario::parse(GOOD, "good.ron").unwrap()).is_ok());
+    let with_strand = |shape: &str| {
+        GOOD.replace(
+            "mass: 2.0),",
+            &format!("mass: 2.0),\n        (shape: {shape}),"),
+        )
+    };
+    // A vertical strand through strand 0 (y = 0.5, x from 0.1 to 0.55).
+    let crossing = with_strand("Polyline(points: [(0.32, 0.4), (0.32, 0.6)])");
+    let problem = refused_at_start(&crossing);
+    assert!(
+        problem.starts_with(
+            "the edge from strands[2] particle 0 to strands[2] particle 1 crosses the edge \
+             from strands[0] particle 4 to strands[0] particle 5 (pairs of edges crossing \
+             at the start: 1)"
+        ),
+        "{problem}"
+    );
+    // A particle 1e-3 above strand 0, inside its cushion.
+    let close = with_strand("Polyline(points: [(0.33, 0.501), (0.33, 0.6)])");
+    let problem = refused_at_start(&close);
+    assert!(
+        problem.starts_with("strands[2] particle 0 is 1.0000000000000009e-3 from the edge from strands[0] particle 4")
+            && problem.contains("closer than the thickness 4e-3"),
+        "{problem}"
+    );
+    // Pinned on the floor: nothing pushes it off, but it touches a wall edge.
+    let on_wall = with_strand("Polyline(points: [(0.7, 0.0), (0.7, 0.1)]), pinned: [0]");
+    let problem = refused_at_start(&on_wall);
+    assert!(problem.contains("the container particle"), "{problem}");
+    assert!(
+        problem.starts_with("the edge from strands[2] particle 0 to strands[2] particle 1 crosses"),
+        "{problem}"
+    );
+    // Entirely outside the box.
+    let outside = with_strand("Polyline(points: [(1.5, 0.5), (1.6, 0.5)])");
+    let problem = refused_at_start(&outside);
+    assert!(
+        problem.starts_with("strands[2] particle 0 at DVec2(1.5, 0.5) is not inside the container"),
+        "{problem}"
+    );
+    // Allowed, with a reason; a reason may not be empty.
+    let allowed = crossing.replace(
+        "duration: 1.0,",
+        "duration: 1.0, allow_initial_contact: Some(\"testing a crossed start\"),",
+    );
+    assert!(headless_app(&Scenario::parse(&allowed, "ok.ron").unwrap()).is_ok());
+    let message = rejected(&crossing.replace(
+        "duration: 1.0,",
+        "duration: 1.0, allow_initial_contact: Some(\" \"),",
+    ));
+    assert!(
+        message.contains("allow_initial_contact: give the reason"),
+        "{message}"
+    );
 }

@@ -18,6 +18,7 @@
 
 pub mod broad_phase;
 pub mod ccd;
+pub mod clearance;
 pub mod crossings;
 pub mod failsafe;
 pub mod impulses;
