@@ -121,3 +121,82 @@ fn a_velocity_that_overflows_in_the_predictor_is_caught_there() {
     assert_eq!(position(&app, p), DVec2::new(0.5, 0.5));
     assert!(app.world().get::<Frozen>(p).is_some());
 }
+
+#[test]
+fn strands_and_particles_past_the_caps_are_left_out_with_a_message() {
+    let mut app = app();
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .max_particles = 25;
+    let world = app.world_mut();
+    let strands: Vec<Entity> = (0..3)
+        .map(|s| {
+            StrandBuilder::line(DVec2::new(0.1, 0.2 + 0.2 * s as f64), DVec2::X, 10, 0.02)
+                .spawn_in(world)
+                .unwrap()
+        })
+        .collect();
+    let loose: Vec<Entity> = (0..7)
+        .map(|i| {
+            let x = DVec2::new(0.1 + 0.05 * i as f64, 0.9);
+            world
+                .spawn((Particle, Position(x), Velocity(DVec2::ZERO)))
+                .id()
+        })
+        .collect();
+    ticks(&mut app, 2);
+    assert_eq!(app.world().resource::<ParticleState>().len(), 25);
+    let simulated =
+        |app: &App, p: Entity| app.world().resource::<Topology>().index.contains_key(&p);
+    // One strand is left out whole (the last in the topology's entity order).
+    let is_in = |app: &App, s: Entity| strand_particles(app, s).iter().all(|&p| simulated(app, p));
+    let out: Vec<Entity> = strands
+        .iter()
+        .copied()
+        .filter(|&s| !is_in(&app, s))
+        .collect();
+    assert_eq!(out.len(), 1);
+    let third = strand_particles(&app, out[0]);
+    assert!(third.iter().all(|&p| !simulated(&app, p)));
+    assert_eq!(loose.iter().filter(|&&p| simulated(&app, p)).count(), 5);
+    // Left out, they stay where they were: not loose particles falling on their own.
+    let start = position(&app, third[0]);
+    tick(&mut app);
+    assert_eq!(position(&app, third[0]), start);
+    let problems = &app.world().resource::<InputProblems>();
+    assert!(problems.entries.iter().any(|p| {
+        p.entity == out[0]
+            && p.problem
+                .starts_with("strand left out: with its 10 particles and 9 edges")
+            && p.problem.contains("max_particles 25")
+    }));
+    assert!(
+        problems
+            .entries
+            .iter()
+            .any(|p| p.problem.starts_with("2 loose particles left out"))
+    );
+
+    // Raised, everything is in at the next rebuild.
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .max_particles = 100;
+    app.world_mut()
+        .resource_mut::<bevy_strands::world::hooks::TopologyDirty>()
+        .mark();
+    tick(&mut app);
+    assert_eq!(app.world().resource::<ParticleState>().len(), 37);
+}
+
+#[test]
+fn a_builder_asked_for_too_many_particles_refuses_without_building_them() {
+    use bevy_strands::model::validate::{MAX_STRAND_PARTICLES, StrandError};
+    let builder = StrandBuilder::line(DVec2::ZERO, DVec2::X, usize::MAX, 1e-3);
+    assert_eq!(builder.points().len(), MAX_STRAND_PARTICLES + 1);
+    assert_eq!(
+        builder.validate(),
+        Err(StrandError::TooManyParticles {
+            max: MAX_STRAND_PARTICLES
+        })
+    );
+}

@@ -125,6 +125,12 @@ pub enum StrandError {
         /// Edge index.
         edge: usize,
     },
+    /// More particles than one strand may have.
+    #[error("a strand may have at most {max} particles, got more")]
+    TooManyParticles {
+        /// The cap, [`MAX_STRAND_PARTICLES`].
+        max: usize,
+    },
     /// A vertex is not a particle that can be simulated (despawned, or refused).
     #[error("vertex {index} is not a particle that can be simulated")]
     NotSimulated {
@@ -132,6 +138,10 @@ pub enum StrandError {
         index: usize,
     },
 }
+
+/// The most particles one strand may have (2²⁴, 256 MiB of positions): a builder
+/// asked for more stops collecting there instead of allocating without bound.
+pub const MAX_STRAND_PARTICLES: usize = 1 << 24;
 
 /// At least two particles for an open strand, three for a closed one.
 pub fn check_particle_count(particles: usize, closed: bool) -> Result<(), StrandError> {

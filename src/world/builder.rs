@@ -6,7 +6,8 @@ use bevy::prelude::*;
 
 use crate::model::geometry::turning_angles;
 use crate::model::validate::{
-    StrandError, check_particle, check_particle_count, check_strand_shape, rest_lengths_of,
+    MAX_STRAND_PARTICLES, StrandError, check_particle, check_particle_count, check_strand_shape,
+    rest_lengths_of,
 };
 use crate::world::particle::{Mass, Particle, Pinned, Position, Velocity};
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
@@ -51,8 +52,10 @@ pub struct RestShape {
 impl StrandBuilder {
     /// A strand through the given points, in order.
     pub fn polyline(points: impl IntoIterator<Item = DVec2>) -> Self {
+        // One past the cap is enough to know it is too many.
+        let points = points.into_iter().take(MAX_STRAND_PARTICLES + 1).collect();
         Self {
-            points: points.into_iter().collect(),
+            points,
             closed: false,
             mass: 1.0,
             velocity: DVec2::ZERO,
@@ -67,6 +70,8 @@ impl StrandBuilder {
 
     /// `count` particles from `start`, `spacing` apart along `direction` (normalized here).
     pub fn line(start: DVec2, direction: DVec2, count: usize, spacing: f64) -> Self {
+        // More than the cap is refused by `validate`; do not build them first.
+        let count = count.min(MAX_STRAND_PARTICLES + 1);
         let step = direction.normalize_or_zero() * spacing;
         Self::polyline((0..count).map(move |i| start + step * i as f64))
     }
@@ -161,6 +166,11 @@ impl StrandBuilder {
     /// run time, and compute its rest lengths and angles.
     pub fn validate(&self) -> Result<RestShape, StrandError> {
         let n = self.points.len();
+        if n > MAX_STRAND_PARTICLES {
+            return Err(StrandError::TooManyParticles {
+                max: MAX_STRAND_PARTICLES,
+            });
+        }
         check_particle_count(n, self.closed)?;
         if let Some(velocities) = &self.velocities
             && velocities.len() != n

@@ -55,7 +55,18 @@ pub struct StrandsConfig {
     /// whatever the count; on the web there is one.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub threads: usize,
+    /// The most particles the world simulates: strands (and loose particles) past it
+    /// are left out at the topology rebuild, with a message in `InputProblems`.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub max_particles: usize,
+    /// The most edges the world simulates, likewise.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub max_edges: usize,
 }
+
+/// [`StrandsConfig::max_particles`] by default: 4 million (about 1 GiB of state and
+/// solver buffers).
+pub const DEFAULT_MAX_PARTICLES: usize = 4_000_000;
 
 impl Default for StrandsConfig {
     fn default() -> Self {
@@ -67,6 +78,8 @@ impl Default for StrandsConfig {
             material: StrandMaterial::default(),
             paused: false,
             threads: 0,
+            max_particles: DEFAULT_MAX_PARTICLES,
+            max_edges: 2 * DEFAULT_MAX_PARTICLES,
         }
     }
 }

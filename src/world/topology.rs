@@ -136,24 +136,63 @@ pub fn rebuild_topology(world: &mut World) {
         .collect();
     strands.sort_by_key(|(entity, ..)| *entity);
 
-    // Packed order: strand by strand along each strand, then loose particles.
-    let mut order: Vec<Entity> = Vec::with_capacity(valid.len());
-    let mut index: EntityHashMap<u32> = EntityHashMap::default();
-    let mut push = |entity: Entity, order: &mut Vec<Entity>| {
-        index.entry(entity).or_insert_with(|| {
-            order.push(entity);
-            (order.len() - 1) as u32
-        });
+    // Packed order: strand by strand along each strand, then loose particles; a strand
+    // or particle past the caps is left out, its particles with it.
+    let (max_particles, max_edges) = {
+        let config = world.resource::<StrandsConfig>();
+        (config.max_particles, config.max_edges)
     };
-    for (_, strand, ..) in &strands {
-        for &p in &strand.particles {
-            push(p, &mut order);
+    let mut order: Vec<Entity> = Vec::with_capacity(valid.len().min(max_particles));
+    let mut index: EntityHashMap<u32> = EntityHashMap::default();
+    let mut left_out: EntityHashMap<()> = EntityHashMap::default();
+    let mut edge_total = 0usize;
+    strands.retain(|(entity, strand, ..)| {
+        let new = strand
+            .particles
+            .iter()
+            .filter(|p| !index.contains_key(*p))
+            .count();
+        let edges = strand.rest_lengths.len();
+        if order.len() + new > max_particles || edge_total + edges > max_edges {
+            problems.report(
+                *entity,
+                format!(
+                    "strand left out: with its {} particles and {edges} edges the world \
+                     would pass max_particles {max_particles} or max_edges {max_edges}",
+                    strand.particles.len()
+                ),
+            );
+            left_out.extend(strand.particles.iter().map(|&p| (p, ())));
+            return false;
         }
-    }
-    let mut loose: Vec<Entity> = valid.keys().copied().collect();
+        edge_total += edges;
+        for &p in &strand.particles {
+            index.entry(p).or_insert_with(|| {
+                order.push(p);
+                (order.len() - 1) as u32
+            });
+        }
+        true
+    });
+    let mut loose: Vec<Entity> = valid
+        .keys()
+        .copied()
+        .filter(|p| !index.contains_key(p) && !left_out.contains_key(p))
+        .collect();
     loose.sort();
-    for p in loose {
-        push(p, &mut order);
+    let room = max_particles - order.len();
+    if let Some(&first) = loose.get(room) {
+        problems.report(
+            first,
+            format!(
+                "{} loose particles left out: the world would pass max_particles {max_particles}",
+                loose.len() - room
+            ),
+        );
+    }
+    for p in loose.into_iter().take(room) {
+        index.insert(p, order.len() as u32);
+        order.push(p);
     }
 
     let mut edges = Vec::new();
