@@ -1,4 +1,5 @@
-//! Threads: a run's report is the same bit for bit on one thread and on two.
+//! Determinism: a run's report is the same bit for bit on one thread and on two, and
+//! from one run to the next.
 
 use bevy_strands_app::report::Report;
 use bevy_strands_app::runner::{RunOptions, run};
@@ -59,4 +60,22 @@ fn the_point_queries_shared_between_threads_give_the_same_report() {
     let report = same_report_on_one_and_two_threads(170, 0.15);
     assert!(report.particles >= 4 * 4096, "{}", report.particles);
     assert!(report.collisions > 0, "the strands reach the floor");
+}
+
+#[test]
+fn a_rerun_gives_the_same_report_bit_for_bit() {
+    // The factories: contact, the fail-safe's zones, emissions and withdrawals all in
+    // one run; each run in a fresh app.
+    for scenario in ["spaghetti_factory", "meatball_factory"] {
+        let options = RunOptions {
+            scenario: scenario.into(),
+            seconds: Some(3.0),
+            check_crossings: true,
+            ..Default::default()
+        };
+        let first = run(&options, |_| {}).unwrap();
+        let second = run(&options, |_| {}).unwrap();
+        assert_eq!(figures(&first), figures(&second), "{scenario}");
+        assert!(first.collisions > 0, "{scenario} reached contact");
+    }
 }
