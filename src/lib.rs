@@ -73,7 +73,9 @@ pub mod prelude {
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
     pub use crate::guard::{FiniteGuard, NonFiniteState};
     pub use crate::metrics::StrandMetrics;
-    pub use crate::schedule::{CollideSet, StepSet, StrandsStep, StrandsTick, TickSet};
+    pub use crate::schedule::{
+        CollideSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
+    };
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
@@ -91,9 +93,12 @@ pub mod prelude {
 
 /// The simulation: all of this crate's plugins.
 ///
-/// By default a tick runs in [`FixedUpdate`], and the fixed timestep follows
-/// [`StrandsConfig::tick_seconds`]. [`StrandsPlugin::manual`] leaves the driving to the
-/// caller (`world.run_schedule(StrandsTick)`), as headless runs and tests do.
+/// By default a tick runs in [`FixedPostUpdate`] (after the game's own fixed-step
+/// systems, as avian does), inside [`StrandsSystems`](schedule::StrandsSystems), and
+/// covers that schedule's delta in [`StrandsConfig::substeps`] steps. The app's
+/// `Time<Fixed>` is the game's: the plugin never changes it. [`StrandsPlugin::manual`]
+/// leaves the driving to the caller (`world.run_schedule(StrandsTick)`), as headless
+/// runs and tests do; the step is then [`StrandsConfig::dt`].
 #[derive(Clone, Debug)]
 pub struct StrandsPlugin {
     /// The schedule that runs a tick; `None` to drive by hand.
@@ -102,7 +107,7 @@ pub struct StrandsPlugin {
 
 impl Default for StrandsPlugin {
     fn default() -> Self {
-        Self::new(FixedUpdate)
+        Self::new(FixedPostUpdate)
     }
 }
 

@@ -29,14 +29,18 @@
 //! 5. **Integrate** — `x += dt v`.
 //! 6. **Measure** — length errors, crossings, counts.
 //!
-//! Each area's plugin adds its systems to these sets; this module fixes their order
-//! and runs the steps. Tests drive the simulation with `world.run_schedule(StrandsTick)`:
-//! no wall clock.
+//! Between stages the finiteness guard (the crate's `guard` module) scans what each
+//! stage wrote. Each area's plugin adds its systems to these sets; this module fixes
+//! their order and runs the steps.
+//!
+//! Driven by a schedule (`FixedPostUpdate` by default), a tick runs inside
+//! [`StrandsSystems`] each time that schedule runs and covers the schedule's delta: the
+//! step is `delta / substeps`. The app's clocks are left alone. Tests drive the
+//! simulation with `world.run_schedule(StrandsTick)`: no wall clock.
 
 use bevy::ecs::schedule::{InternedScheduleLabel, LogLevel, ScheduleBuildSettings, ScheduleLabel};
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
-use bevy::time::Fixed;
 
 use crate::world::clock::StepTiming;
 use crate::world::config::StrandsConfig;
@@ -107,6 +111,12 @@ pub enum CollideSet {
     Account,
 }
 
+/// The system set, in the driving schedule, that runs a tick: order your own systems
+/// `.before(StrandsSystems)` (to push on strands) or `.after(StrandsSystems)` (to read
+/// where they went).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct StrandsSystems;
+
 /// Sets up the two schedules and the order of their sets, and runs the steps.
 pub struct SchedulePlugin {
     /// The schedule that runs a tick each time it runs; `None` to drive by hand.
@@ -170,8 +180,7 @@ impl Plugin for SchedulePlugin {
         app.add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
 
         if let Some(driver) = self.driver {
-            app.add_systems(driver, drive_tick);
-            app.add_systems(PreUpdate, sync_fixed_timestep);
+            app.add_systems(driver, drive_tick.in_set(StrandsSystems));
         }
     }
 }
@@ -205,10 +214,19 @@ fn run_steps(world: &mut World) {
     timing.last_tick_seconds = seconds;
 }
 
-/// Run one tick (the driver schedule's system); paused, one that takes no step.
+/// Run one tick covering the driving schedule's delta (the driver schedule's system);
+/// paused, or with no time elapsed, one that takes no step.
 fn drive_tick(world: &mut World) {
-    let paused = world.resource::<StrandsConfig>().paused;
-    world.insert_resource(SyncOnly(paused));
+    let delta = world.resource::<Time>().delta_secs_f64();
+    let mut config = world.resource_mut::<StrandsConfig>();
+    let dt = delta / config.substeps.max(1) as f64;
+    let stepping = !config.paused && dt.is_finite() && dt > 0.0;
+    // Written only when it changes, so a fixed schedule does not mark the config
+    // changed every tick.
+    if stepping && config.dt != dt {
+        config.dt = dt;
+    }
+    world.insert_resource(SyncOnly(!stepping));
     world.run_schedule(StrandsTick);
     world.insert_resource(SyncOnly(false));
 }
@@ -221,16 +239,4 @@ pub fn synchronise(world: &mut World) {
     // Err only when the schedule does not exist: then there is nothing to synchronise.
     let _ = world.try_run_schedule(StrandsTick);
     world.insert_resource(SyncOnly(false));
-}
-
-/// Keep the fixed timestep equal to the simulated time of one tick.
-fn sync_fixed_timestep(config: Res<StrandsConfig>, fixed: Option<ResMut<Time<Fixed>>>) {
-    if let Some(mut fixed) = fixed
-        && config.is_changed()
-    {
-        let seconds = config.tick_seconds();
-        if seconds.is_finite() && seconds > 0.0 {
-            fixed.set_timestep_seconds(seconds);
-        }
-    }
 }

@@ -38,9 +38,10 @@ use crate::world::strand::StrandMaterial;
 )]
 #[reflect(Resource)]
 pub struct StrandsConfig {
-    /// Step size in seconds.
+    /// Step size in seconds. Driven by a schedule, the plugin sets it to the
+    /// schedule's delta divided by `substeps`; driven by hand, it is the step.
     pub dt: f64,
-    /// Steps per fixed tick.
+    /// Steps per tick.
     pub substeps: u32,
     /// Gravity acceleration.
     pub gravity: DVec2,

@@ -4,6 +4,7 @@
 use bevy::camera::ScalingMode;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
+use bevy_strands::prelude::StrandsConfig;
 use bevy_strands::render::{StrandGizmos, draw_strands, units_per_pixel};
 
 use super::layout::UiLayout;
@@ -18,6 +19,7 @@ impl Plugin for DemoViewPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<UiLayout>()
             .add_systems(Startup, (spawn_camera, spawn_active_scenario))
+            .add_systems(PreUpdate, fixed_rate_follows_the_scene)
             .add_systems(
                 Update,
                 (
@@ -26,6 +28,18 @@ impl Plugin for DemoViewPlugin {
                     draw_hovered.after(draw_strands),
                 ),
             );
+    }
+}
+
+/// The demo owns its clock: its fixed rate is the scene's tick (`dt` × `substeps`), so
+/// the step the plugin takes from it is the scene's `dt`, also after the panel edits it.
+fn fixed_rate_follows_the_scene(config: Res<StrandsConfig>, mut fixed: ResMut<Time<Fixed>>) {
+    let seconds = config.tick_seconds();
+    let Ok(timestep) = std::time::Duration::try_from_secs_f64(seconds) else {
+        return;
+    };
+    if config.is_changed() && !timestep.is_zero() && fixed.timestep() != timestep {
+        fixed.set_timestep(timestep);
     }
 }
 

@@ -1,0 +1,104 @@
+//! Driven by a schedule: the plugin steps by that schedule's delta and leaves the app's
+//! clocks alone, and user systems order themselves around the tick.
+
+use std::time::Duration;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use bevy_strands::prelude::*;
+
+/// A game's app: its own fixed rate (50 Hz here, not Bevy's 64 Hz default), frames of
+/// 1/60 s, and the plugin in its default schedule.
+fn game() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, StrandsPlugin::default()));
+    app.insert_resource(Time::<Fixed>::from_hz(50.0));
+    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+        1.0 / 60.0,
+    )));
+    app.world_mut().spawn((
+        Particle,
+        Position(DVec2::new(0.5, 0.9)),
+        Velocity(DVec2::ZERO),
+    ));
+    app
+}
+
+#[test]
+fn the_fixed_clock_is_the_games_and_the_step_is_its_delta_over_the_substeps() {
+    let mut app = game();
+    for _ in 0..90 {
+        app.update();
+    }
+    let fixed = app.world().resource::<Time<Fixed>>();
+    assert_eq!(fixed.timestep(), Duration::from_millis(20));
+    let config = app.world().resource::<StrandsConfig>();
+    assert_eq!(config.dt, 0.02 / config.substeps as f64);
+    // Every fixed tick of the game took one tick of the simulation.
+    let clock = app.world().resource::<SimulationClock>();
+    let ticks = (fixed.elapsed_secs_f64() / 0.02).round() as u64;
+    assert!(ticks > 60, "{ticks} fixed ticks in 1.5 s");
+    assert_eq!(clock.steps, ticks * config.substeps as u64);
+    assert!((clock.time - fixed.elapsed_secs_f64()).abs() < 1e-9);
+
+    // Changing the simulation's settings does not touch the game's clock.
+    app.world_mut().resource_mut::<StrandsConfig>().substeps = 3;
+    app.update();
+    app.update();
+    assert_eq!(
+        app.world().resource::<Time<Fixed>>().timestep(),
+        Duration::from_millis(20)
+    );
+    assert_eq!(app.world().resource::<StrandsConfig>().dt, 0.02 / 3.0);
+}
+
+#[test]
+fn paused_the_simulation_takes_no_step_while_the_game_runs_on() {
+    let mut app = game();
+    for _ in 0..10 {
+        app.update();
+    }
+    let steps = app.world().resource::<SimulationClock>().steps;
+    assert!(steps > 0);
+    app.world_mut().resource_mut::<StrandsConfig>().paused = true;
+    for _ in 0..10 {
+        app.update();
+    }
+    assert_eq!(app.world().resource::<SimulationClock>().steps, steps);
+    app.world_mut().resource_mut::<StrandsConfig>().paused = false;
+    app.update();
+    app.update();
+    assert!(app.world().resource::<SimulationClock>().steps > steps);
+}
+
+#[derive(Resource, Default)]
+struct Seen(Vec<(&'static str, u64)>);
+
+#[test]
+fn systems_ordered_around_the_tick_see_the_state_before_and_after_it() {
+    let mut app = game();
+    app.init_resource::<Seen>();
+    let record = |label: &'static str| {
+        move |clock: Res<SimulationClock>, mut seen: ResMut<Seen>| {
+            seen.0.push((label, clock.steps));
+        }
+    };
+    app.add_systems(
+        FixedPostUpdate,
+        (
+            record("before").before(StrandsSystems),
+            record("after").after(StrandsSystems),
+        ),
+    );
+    for _ in 0..5 {
+        app.update();
+    }
+    let substeps = app.world().resource::<StrandsConfig>().substeps as u64;
+    let seen = &app.world().resource::<Seen>().0;
+    assert!(seen.len() >= 4, "{seen:?}");
+    for pair in seen.chunks(2) {
+        assert_eq!(pair[0].0, "before");
+        assert_eq!(pair[1], ("after", pair[0].1 + substeps));
+    }
+}
