@@ -46,6 +46,7 @@ pub mod model;
 pub mod render;
 pub mod schedule;
 pub mod snapshot;
+pub mod transforms;
 pub mod world;
 
 use bevy::app::PluginGroupBuilder;
@@ -76,6 +77,7 @@ pub mod prelude {
     pub use crate::schedule::{
         CollideSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
     };
+    pub use crate::transforms::{SyncTransform, TickPositions};
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
@@ -137,6 +139,7 @@ impl PluginGroup for StrandsPlugin {
             .add(ConstraintsPlugin)
             .add(CollisionPlugin)
             .add(ContactLoopPlugin)
+            .add(transforms::TransformSyncPlugin)
     }
 }
 

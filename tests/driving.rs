@@ -102,3 +102,71 @@ fn systems_ordered_around_the_tick_see_the_state_before_and_after_it() {
         assert_eq!(pair[1], ("after", pair[0].1 + substeps));
     }
 }
+
+#[test]
+fn a_synced_particles_transform_follows_its_position() {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, StrandsPlugin::manual()));
+    let start = DVec2::new(0.25, 0.75);
+    let p = app
+        .world_mut()
+        .spawn((
+            Particle,
+            Position(start),
+            Velocity(DVec2::new(1.0, 0.0)),
+            SyncTransform { interpolate: false },
+            Transform::from_xyz(0.0, 0.0, 3.0),
+        ))
+        .id();
+    // Before any tick: where it was spawned, its z kept.
+    app.update();
+    let translation = |app: &App| app.world().get::<Transform>(p).unwrap().translation;
+    assert_eq!(translation(&app), Vec3::new(0.25, 0.75, 3.0));
+    for _ in 0..3 {
+        app.world_mut().run_schedule(StrandsTick);
+        app.update();
+        let x = app.world().get::<Position>(p).unwrap().0;
+        assert_eq!(translation(&app), x.as_vec2().extend(3.0));
+    }
+    // Three ticks of 6 × 1/600 s at 1 m/s.
+    assert!((translation(&app).x - 0.28).abs() < 1e-6);
+}
+
+#[test]
+fn interpolated_transforms_land_between_the_last_two_ticks() {
+    let mut app = game();
+    let p = app
+        .world_mut()
+        .spawn((
+            Particle,
+            Position(DVec2::new(0.5, 0.5)),
+            Velocity(DVec2::new(2.0, 0.0)),
+            SyncTransform::default(),
+        ))
+        .id();
+    let mut strictly_between = 0;
+    for _ in 0..40 {
+        app.update();
+        if app.world().resource::<SimulationClock>().steps == 0 {
+            continue;
+        }
+        let ticks = *app.world().get::<TickPositions>(p).unwrap();
+        let alpha = app
+            .world()
+            .resource::<Time<Fixed>>()
+            .overstep_fraction_f64();
+        let x = app.world().get::<Transform>(p).unwrap().translation.x;
+        assert_eq!(x, ticks.at(alpha).x as f32);
+        if ticks.previous.x < ticks.current.x
+            && x > ticks.previous.x as f32
+            && x < ticks.current.x as f32
+        {
+            strictly_between += 1;
+        }
+    }
+    // Frames of 1/60 s against ticks of 1/50 s: most frames fall inside a tick.
+    assert!(
+        strictly_between > 20,
+        "{strictly_between} of 40 frames between ticks"
+    );
+}
