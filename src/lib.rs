@@ -44,6 +44,7 @@ pub mod metrics;
 pub mod model;
 #[cfg(feature = "render")]
 pub mod render;
+pub mod ribbon;
 pub mod schedule;
 pub mod snapshot;
 pub mod transforms;

@@ -49,6 +49,11 @@ impl TickPositions {
     pub fn at(&self, alpha: f64) -> DVec2 {
         self.previous.lerp(self.current, alpha.clamp(0.0, 1.0))
     }
+
+    /// Whether a tick has ended since the particle got these (before, they are zero).
+    pub fn is_recorded(&self) -> bool {
+        self.recorded
+    }
 }
 
 /// Records tick positions and writes transforms.
@@ -92,7 +97,7 @@ fn write_transforms(
     for (sync, ticks, position, mut transform) in &mut particles {
         let alpha = if sync.interpolate { overstep } else { 1.0 };
         // Before its first tick a particle shows where it was spawned.
-        let at = if ticks.recorded {
+        let at = if ticks.is_recorded() {
             ticks.at(alpha)
         } else {
             position.0

@@ -16,7 +16,7 @@
 //! ```
 
 mod layout;
-mod screenshot;
+pub mod screenshot;
 mod tools;
 mod ui;
 mod view;
