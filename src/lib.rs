@@ -62,7 +62,7 @@ use integrate::IntegratorPlugin;
 use metrics::MetricsPlugin;
 use schedule::{SchedulePlugin, StrandsTick, TickSet};
 use world::clock::SimulationClock;
-use world::config::StrandsConfig;
+use world::config::{CollisionConfig, LengthUnit, StrandsConfig};
 use world::hooks::TopologyDirty;
 use world::problems::InputProblems;
 use world::state::ParticleState;
@@ -82,7 +82,7 @@ pub mod prelude {
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
-        CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig,
+        CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, StrandsConfig,
     };
     pub use crate::world::particle::{
         ExternalForce, Frozen, Mass, Particle, Pinned, Position, Tether, Velocity,
@@ -106,6 +106,8 @@ pub mod prelude {
 pub struct StrandsPlugin {
     /// The schedule that runs a tick; `None` to drive by hand.
     pub driver: Option<InternedScheduleLabel>,
+    /// World units per metre ([`LengthUnit`]).
+    pub length_unit: f64,
 }
 
 impl Default for StrandsPlugin {
@@ -119,12 +121,23 @@ impl StrandsPlugin {
     pub fn new(schedule: impl ScheduleLabel) -> Self {
         Self {
             driver: Some(schedule.intern()),
+            length_unit: 1.0,
         }
     }
 
     /// Never tick on its own: the caller runs [`StrandsTick`](schedule::StrandsTick).
     pub fn manual() -> Self {
-        Self { driver: None }
+        Self {
+            driver: None,
+            length_unit: 1.0,
+        }
+    }
+
+    /// A world of `unit` world units per metre (100 for 100 pixels a metre): the
+    /// defaults that carry a length are scaled ([`LengthUnit`]).
+    pub fn with_length_unit(mut self, unit: f64) -> Self {
+        self.length_unit = unit;
+        self
     }
 }
 
@@ -133,6 +146,7 @@ impl PluginGroup for StrandsPlugin {
         PluginGroupBuilder::start::<Self>()
             .add(StrandsCorePlugin {
                 driver: self.driver,
+                length_unit: self.length_unit,
             })
             .add(ForcesPlugin)
             .add(IntegratorPlugin)
@@ -150,11 +164,22 @@ impl PluginGroup for StrandsPlugin {
 pub struct StrandsCorePlugin {
     /// The schedule that runs a tick; `None` to drive by hand.
     pub driver: Option<InternedScheduleLabel>,
+    /// World units per metre ([`LengthUnit`]).
+    pub length_unit: f64,
 }
 
 impl Plugin for StrandsCorePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<StrandsConfig>()
+        // The length unit's defaults, unless the app inserted its own settings first.
+        let unit = self.length_unit;
+        app.insert_resource(LengthUnit(unit));
+        if !app.world().contains_resource::<StrandsConfig>() {
+            app.insert_resource(StrandsConfig::with_length_unit(unit));
+        }
+        if !app.world().contains_resource::<CollisionConfig>() {
+            app.insert_resource(CollisionConfig::with_length_unit(unit));
+        }
+        app.register_type::<LengthUnit>()
             .init_resource::<ParticleState>()
             .init_resource::<Topology>()
             .init_resource::<TopologyDirty>()

@@ -170,3 +170,58 @@ fn interpolated_transforms_land_between_the_last_two_ticks() {
         "{strictly_between} of 40 frames between ticks"
     );
 }
+
+/// A rope that swings down onto a floor, in a world of `unit` world units per metre.
+fn rope_world(unit: f64) -> (App, Entity) {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        StrandsPlugin::manual().with_length_unit(unit),
+    ));
+    let world = app.world_mut();
+    StrandBuilder::polyline([DVec2::new(0.0, 0.1), DVec2::new(1.0, 0.1)].map(|p| p * unit))
+        .pin(0)
+        .pin(1)
+        .kind(StrandKind::Wall)
+        .material(StrandMaterial::INERT)
+        .spawn_in(world)
+        .unwrap();
+    let rope = StrandBuilder::line(DVec2::new(0.3, 0.4) * unit, DVec2::X, 20, 0.02 * unit)
+        .pin_first()
+        .spawn_in(world)
+        .unwrap();
+    (app, rope)
+}
+
+#[test]
+fn a_pixel_world_with_its_length_unit_moves_as_the_metre_world_scaled() {
+    let (mut metres, rope_m) = rope_world(1.0);
+    let (mut pixels, rope_px) = rope_world(100.0);
+    let unit = pixels.world().resource::<LengthUnit>().0;
+    assert_eq!(unit, 100.0);
+    assert_eq!(pixels.world().resource::<CollisionConfig>().thickness, 0.4);
+    assert_eq!(pixels.world().resource::<StrandsConfig>().gravity.y, -981.0);
+    let mut landed = false;
+    for _ in 0..120 {
+        metres.world_mut().run_schedule(StrandsTick);
+        pixels.world_mut().run_schedule(StrandsTick);
+        let particles = |app: &App, s: Entity| -> Vec<DVec2> {
+            let strand = app.world().get::<Strand>(s).unwrap();
+            strand
+                .particles
+                .iter()
+                .map(|&p| app.world().get::<Position>(p).unwrap().0)
+                .collect()
+        };
+        for (m, px) in particles(&metres, rope_m)
+            .iter()
+            .zip(particles(&pixels, rope_px))
+        {
+            assert!(m.distance(px / unit) < 1e-9, "{m} against {}", px / unit);
+        }
+        landed |= metres.world().resource::<StrandMetrics>().collisions > 0;
+    }
+    assert!(landed, "the rope reached the floor");
+    let error = |app: &App| app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error(&metres) < 1e-9 && error(&pixels) < 1e-9);
+}

@@ -65,6 +65,22 @@ pub struct StrandsConfig {
     pub max_edges: usize,
 }
 
+/// World units per metre (like avian's `PhysicsLengthUnit`): 1 for a world in metres,
+/// 100 for one in pixels at 100 pixels a metre. It scales the defaults that carry a
+/// length — gravity, the collision thickness, the default material's stiffness — so a
+/// scaled world behaves as the metre world does, scaled; every other tolerance of the
+/// crate is relative already (to the thickness or to rest lengths). Set it through
+/// `StrandsPlugin::with_length_unit`; it does not rescale configurations you insert.
+#[derive(Resource, Reflect, Clone, Copy, Debug, PartialEq)]
+#[reflect(Resource)]
+pub struct LengthUnit(pub f64);
+
+impl Default for LengthUnit {
+    fn default() -> Self {
+        LengthUnit(1.0)
+    }
+}
+
 /// [`StrandsConfig::max_particles`] by default: 4 million (about 1 GiB of state and
 /// solver buffers).
 pub const DEFAULT_MAX_PARTICLES: usize = 4_000_000;
@@ -86,6 +102,17 @@ impl Default for StrandsConfig {
 }
 
 impl StrandsConfig {
+    /// The defaults for a world of `unit` world units per metre: gravity and the
+    /// default material scaled with it.
+    pub fn with_length_unit(unit: f64) -> Self {
+        let default = Self::default();
+        Self {
+            gravity: default.gravity * unit,
+            material: default.material.with_length_unit(unit),
+            ..default
+        }
+    }
+
     /// Simulated seconds per fixed tick.
     pub fn tick_seconds(&self) -> f64 {
         self.dt * self.substeps as f64
@@ -235,6 +262,15 @@ impl Default for CollisionConfig {
 }
 
 impl CollisionConfig {
+    /// The defaults for a world of `unit` world units per metre: the thickness scaled.
+    pub fn with_length_unit(unit: f64) -> Self {
+        let default = Self::default();
+        Self {
+            thickness: default.thickness * unit,
+            ..default
+        }
+    }
+
     /// Check every number against its meaning.
     pub fn validate(&self) -> Result<(), NumberError> {
         positive("thickness", self.thickness)?;

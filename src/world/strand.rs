@@ -119,6 +119,19 @@ impl StrandMaterial {
         bending_damping: 0.0,
     };
 
+    /// This material in a world of `unit` world units per metre, masses unchanged:
+    /// forces scale with the unit, so the stretch stiffness (a force) by `unit`, the
+    /// bending stiffness (force × length²) by `unit³` and its damping by `unit²`; the
+    /// stretch damping (force per speed) is the same.
+    pub fn with_length_unit(self, unit: f64) -> Self {
+        Self {
+            stretch_stiffness: self.stretch_stiffness * unit,
+            stretch_damping: self.stretch_damping,
+            bending_stiffness: self.bending_stiffness * unit.powi(3),
+            bending_damping: self.bending_damping * unit.powi(2),
+        }
+    }
+
     /// Every coefficient must be finite and not negative.
     pub fn validate(&self) -> Result<(), NumberError> {
         non_negative("stretch_stiffness", self.stretch_stiffness)?;
