@@ -13,8 +13,7 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy_strands::prelude::*;
 use bevy_strands::ribbon::{StrandRibbon, StrandRibbonPlugin};
-use bevy_strands_app::window::screenshot::ScreenshotPlugin;
-use bevy_strands_app::window::window_plugins;
+use bevy_strands_app::window::{ScreenshotPlugin, window_plugins};
 
 /// The world the camera shows, in metres.
 const VIEW: Vec2 = Vec2::new(2.4, 1.35);

@@ -16,7 +16,7 @@
 //! ```
 
 mod layout;
-pub mod screenshot;
+mod screenshot;
 mod tools;
 mod ui;
 mod view;
@@ -34,7 +34,7 @@ use crate::spawn::spawn_scenario;
 pub use layout::UiLayout;
 pub use screenshot::ScreenshotPlugin;
 pub use tools::{Tool, ToolState};
-pub use ui::StrandsUiPlugin;
+pub use ui::{StrandsUiPlugin, UiKeys};
 pub use view::DemoViewPlugin;
 
 /// Bevy's default plugins for an example window: 1280×720, titled.

@@ -40,12 +40,71 @@ const PLOT_SAMPLES: usize = 20_000;
 /// The panel, the mouse tools, the shortcuts, frame export and the opt-in screenshot.
 pub struct StrandsUiPlugin;
 
+/// The panel's keyboard shortcuts; `None` turns one off, [`UiKeys::none`] all of them.
+#[derive(Resource, Clone, Debug, PartialEq)]
+pub struct UiKeys {
+    /// Run or pause the simulation.
+    pub pause: Option<KeyCode>,
+    /// Restart the scenario.
+    pub reset: Option<KeyCode>,
+    /// Start or stop recording frames.
+    pub record: Option<KeyCode>,
+    /// One more substep per tick.
+    pub more_substeps: Option<KeyCode>,
+    /// One substep fewer per tick.
+    pub fewer_substeps: Option<KeyCode>,
+}
+
+impl Default for UiKeys {
+    fn default() -> Self {
+        Self {
+            pause: Some(KeyCode::Space),
+            reset: Some(KeyCode::KeyR),
+            record: Some(KeyCode::KeyE),
+            more_substeps: Some(KeyCode::Equal),
+            fewer_substeps: Some(KeyCode::Minus),
+        }
+    }
+}
+
+impl UiKeys {
+    /// No shortcuts: the game's keys are the game's.
+    pub fn none() -> Self {
+        Self {
+            pause: None,
+            reset: None,
+            record: None,
+            more_substeps: None,
+            fewer_substeps: None,
+        }
+    }
+
+    /// The help line the panel shows.
+    fn help(&self) -> String {
+        let name = |key: Option<KeyCode>, what: &str| {
+            key.map(|k| format!("{} {what}", format!("{k:?}").trim_start_matches("Key")))
+        };
+        [
+            name(self.pause, "run/pause"),
+            name(self.reset, "reset"),
+            name(self.record, "record frames"),
+            name(self.more_substeps, "more substeps"),
+            name(self.fewer_substeps, "fewer substeps"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect::<Vec<_>>()
+        .join(" · ")
+    }
+}
+
 impl Plugin for StrandsUiPlugin {
     fn build(&self, app: &mut App) {
         if !app.is_plugin_added::<EguiPlugin>() {
             app.add_plugins(EguiPlugin::default());
         }
         app.init_resource::<ToolState>()
+            .init_resource::<UiKeys>()
             .init_resource::<UiLayout>()
             .init_resource::<LengthErrorHistory>()
             .insert_resource(FrameExport {
@@ -95,6 +154,7 @@ fn panel(
     mut settings: Settings,
     figures: Figures,
     mut tools: ResMut<ToolState>,
+    keys: Res<UiKeys>,
     mut layout: ResMut<UiLayout>,
     mut commands: Commands,
 ) -> Result {
@@ -120,6 +180,10 @@ fn panel(
             figures_ui(ui, &figures, &settings);
             ui.separator();
             tools_ui(ui, &mut tools);
+            let help = keys.help();
+            if !help.is_empty() {
+                ui.small(help);
+            }
             ui.separator();
             egui::CollapsingHeader::new("solver, collisions, drawing")
                 .default_open(true)
@@ -256,7 +320,6 @@ fn tools_ui(ui: &mut egui::Ui, tools: &mut ToolState) {
     if let Some(message) = &tools.message {
         ui.colored_label(egui::Color32::LIGHT_RED, message);
     }
-    ui.small("space run/pause · r reset · e record frames · = / − substeps");
 }
 
 fn solver_ui(ui: &mut egui::Ui, settings: &mut Settings) {
@@ -296,9 +359,11 @@ fn solver_ui(ui: &mut egui::Ui, settings: &mut Settings) {
     });
 }
 
-/// Space run/pause, R reset, E record frames, = and − substeps.
+/// The shortcuts of [`UiKeys`] (by default space run/pause, R reset, E record frames,
+/// = and − substeps).
 fn shortcuts(
     keys: Res<ButtonInput<KeyCode>>,
+    bindings: Res<UiKeys>,
     layout: Res<UiLayout>,
     mut step: ResMut<StrandsConfig>,
     mut collisions: ResMut<CollisionConfig>,
@@ -308,19 +373,20 @@ fn shortcuts(
     if layout.keyboard_over_ui {
         return;
     }
-    if keys.just_pressed(KeyCode::Space) {
+    let pressed = |key: Option<KeyCode>| key.is_some_and(|k| keys.just_pressed(k));
+    if pressed(bindings.pause) {
         step.paused = !step.paused;
     }
-    if keys.just_pressed(KeyCode::KeyR) {
+    if pressed(bindings.reset) {
         commands.queue(reset);
     }
-    if keys.just_pressed(KeyCode::KeyE) {
+    if pressed(bindings.record) {
         commands.queue(toggle_export);
     }
-    if keys.any_just_pressed([KeyCode::Equal, KeyCode::NumpadAdd]) {
+    if pressed(bindings.more_substeps) {
         step.substeps += 1;
     }
-    if keys.any_just_pressed([KeyCode::Minus, KeyCode::NumpadSubtract]) && step.substeps > 1 {
+    if pressed(bindings.fewer_substeps) && step.substeps > 1 {
         step.substeps -= 1;
     }
     // Crossings counted from when checking is switched on.
