@@ -28,7 +28,7 @@ export VK_ICD_FILENAMES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 export WGPU_BACKEND=vulkan
 mkdir -p "$out"
 
-for example in long_strand spaghetti_factory meatball_factory furry_creature branches sandbox; do
+for example in long_strand spaghetti_factory meatball_factory furry_creature branches sandbox game; do
     echo "== $example"
     STRANDS_SCREENSHOT="$out/$example.png" STRANDS_SCREENSHOT_FRAME="$frames" \
         xvfb-run -a -s '-screen 0 1280x720x24' "target/debug/examples/$example" \
