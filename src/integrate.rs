@@ -1,8 +1,8 @@
 //! Symplectic Euler: the predictor (`v* = v + dt f / m`) and the position update
 //! (`x += dt v`) from the velocities the constraint and collision stages filtered.
 //!
-//! Pinned particles have inverse mass 0, so the predictor leaves their prescribed
-//! velocity alone and they move kinematically.
+//! Pinned and kinematic particles have inverse mass 0, so the predictor leaves their
+//! velocity alone: zero for a pinned one, the prescribed one for a kinematic one.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;

@@ -85,7 +85,7 @@ pub mod prelude {
         CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, StrandsConfig,
     };
     pub use crate::world::particle::{
-        ExternalForce, Frozen, Mass, Particle, Pinned, Position, Tether, Velocity,
+        ExternalForce, Frozen, Kinematic, Mass, Particle, Pinned, Position, Tether, Velocity,
     };
     pub use crate::world::problems::InputProblems;
     pub use crate::world::state::ParticleState;
@@ -192,6 +192,7 @@ impl Plugin for StrandsCorePlugin {
             .register_type::<world::particle::Velocity>()
             .register_type::<world::particle::Mass>()
             .register_type::<world::particle::Pinned>()
+            .register_type::<world::particle::Kinematic>()
             .register_type::<world::particle::ExternalForce>()
             .register_type::<world::particle::Tether>()
             .register_type::<world::strand::Strand>()

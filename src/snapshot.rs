@@ -14,8 +14,13 @@ use bevy::prelude::*;
 
 use crate::schedule::synchronise;
 use crate::world::clock::SimulationClock;
-use crate::world::particle::{ExternalForce, Mass, Particle, Pinned, Position, Velocity};
+use crate::world::particle::{
+    ExternalForce, Kinematic, Mass, Particle, Pinned, Position, Velocity,
+};
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
+
+/// The snapshot format written by [`StrandsSnapshot::capture`].
+pub const SNAPSHOT_VERSION: u32 = 1;
 
 /// A particle as captured.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +35,9 @@ pub struct ParticleRecord {
     /// Whether it is pinned.
     #[cfg_attr(feature = "serde", serde(default))]
     pub pinned: bool,
+    /// Whether it is kinematic.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub kinematic: bool,
     /// Its constant external force, if it has one.
     #[cfg_attr(feature = "serde", serde(default))]
     pub external_force: Option<DVec2>,
@@ -64,6 +72,11 @@ pub struct StrandRecord {
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StrandsSnapshot {
+    /// The format: [`SNAPSHOT_VERSION`] for a snapshot written now; 0 (absent) for one
+    /// written before kinematic particles had a marker of their own, when a pinned
+    /// particle moved with its velocity — such a particle is restored kinematic.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub version: u32,
     /// Simulated time and steps.
     pub clock: SimulationClock,
     /// Every particle, in entity order.
@@ -158,6 +171,7 @@ impl StrandsSnapshot {
                     velocity: entity.get::<Velocity>().map_or(DVec2::ZERO, |v| v.0),
                     mass: entity.get::<Mass>().map_or(1.0, |m| m.0),
                     pinned: entity.contains::<Pinned>(),
+                    kinematic: entity.contains::<Kinematic>(),
                     external_force: entity.get::<ExternalForce>().map(|f| f.0),
                     owner: entity
                         .get::<StrandOf>()
@@ -188,6 +202,7 @@ impl StrandsSnapshot {
             })
             .collect();
         let snapshot = StrandsSnapshot {
+            version: SNAPSHOT_VERSION,
             clock: *world.resource::<SimulationClock>(),
             particles,
             strands,
@@ -249,7 +264,11 @@ impl StrandsSnapshot {
                 Velocity(record.velocity),
                 Mass(record.mass),
             ));
-            if record.pinned {
+            // Before version 1 a pinned particle with a velocity was driven by it.
+            let moving_pin = self.version == 0 && record.velocity != DVec2::ZERO;
+            if record.kinematic || record.pinned && moving_pin {
+                entity.insert(Kinematic);
+            } else if record.pinned {
                 entity.insert(Pinned);
             }
             if let Some(force) = record.external_force {

@@ -252,7 +252,7 @@ fn a_kinematic_particle_driven_into_a_pile_against_the_floor_is_reported_at_once
             Particle,
             Position(DVec2::new(0.5, 0.1)),
             Velocity(DVec2::new(0.0, -2.0)),
-            Pinned,
+            Kinematic,
         ))
         .id();
     ticks(&mut app, 10);

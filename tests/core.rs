@@ -41,12 +41,24 @@ fn pinned_particle_stays_put_and_driven_one_moves_kinematically() {
         .unwrap();
     let driven = app
         .world_mut()
-        .spawn((Particle, Pinned, Position(DVec2::ZERO), Velocity(DVec2::X)))
+        .spawn((
+            Particle,
+            Kinematic,
+            Position(DVec2::ZERO),
+            Velocity(DVec2::X),
+        ))
+        .id();
+    // Pinned means fixed: a velocity given to a pinned particle moves nothing.
+    let fixed = app
+        .world_mut()
+        .spawn((Particle, Pinned, Position(DVec2::Y), Velocity(DVec2::X)))
         .id();
     let anchor = strand_particles(&app, rope)[0];
     ticks(&mut app, 50);
     assert_eq!(position(&app, anchor), DVec2::new(0.5, 0.9));
     assert_eq!(velocity(&app, anchor), DVec2::ZERO);
+    assert_eq!(position(&app, fixed), DVec2::Y);
+    assert_eq!(velocity(&app, fixed), DVec2::ZERO);
     // 50 ticks of 1/100 s at unit speed, untouched by gravity.
     assert!((position(&app, driven) - DVec2::new(0.5, 0.0)).length() < 1e-12);
     // The free end swings.

@@ -232,9 +232,12 @@ pub struct ParticleSpec {
     /// Mass.
     #[serde(default = "one")]
     pub mass: f64,
-    /// Pinned.
+    /// Pinned: fixed where it is (its velocity is ignored).
     #[serde(default)]
     pub pinned: bool,
+    /// Kinematic: infinite mass, moving with its velocity (ignored if pinned).
+    #[serde(default)]
+    pub kinematic: bool,
 }
 
 pub(crate) fn vec2(v: [f64; 2]) -> DVec2 {

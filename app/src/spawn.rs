@@ -101,6 +101,8 @@ pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), Scenari
         ));
         if particle.pinned {
             entity.insert(Pinned);
+        } else if particle.kinematic {
+            entity.insert(Kinematic);
         }
         let id = entity.id();
         items.name(id, format!("particles[{i}]"));

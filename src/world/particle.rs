@@ -46,13 +46,21 @@ impl Default for Mass {
     }
 }
 
-/// A pinned particle has infinite mass: forces, constraints and collisions never move
-/// it. It still moves with its own [`Velocity`], so a pinned particle can be driven
-/// kinematically (the factory inlet, a hair root on a moving body).
+/// A pinned particle is fixed: forces, constraints and collisions never move it, and
+/// its velocity is zero whatever its [`Velocity`] says (the gather zeroes it). To drive
+/// a particle along a path of your own, mark it [`Kinematic`] instead.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default)]
 #[reflect(Component)]
 #[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
 pub struct Pinned;
+
+/// A kinematic particle has infinite mass like a pinned one, but moves with its own
+/// [`Velocity`]: the particle a user drives (a factory's inlet, a hand dragging a
+/// rope's end). [`Pinned`] on the same particle wins.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default)]
+#[reflect(Component)]
+#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+pub struct Kinematic;
 
 /// A particle held where the finiteness guard froze it (a non-finite value appeared in
 /// its island): simulated as pinned with zero velocity until the marker is removed.

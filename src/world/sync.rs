@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use crate::model::validate::check_particle;
 use crate::world::hooks::TopologyDirty;
 use crate::world::particle::{
-    ExternalForce, Frozen, Mass, Particle, Position, SolverIndex, Velocity,
+    ExternalForce, Frozen, Mass, Particle, Pinned, Position, SolverIndex, Velocity,
 };
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
@@ -24,6 +24,7 @@ type GatherQuery<'w, 's> = Query<
         &'static Velocity,
         &'static Mass,
         Option<&'static ExternalForce>,
+        Has<Pinned>,
         Has<Frozen>,
     ),
     With<Particle>,
@@ -37,7 +38,7 @@ pub fn gather(
     mut problems: ResMut<InputProblems>,
     particles: GatherQuery,
 ) {
-    for (entity, index, position, velocity, mass, external, frozen) in &particles {
+    for (entity, index, position, velocity, mass, external, fixed, frozen) in &particles {
         let Some(i) = index.get() else { continue };
         let pinned = topology.pinned[i];
         if let Err(problem) = check_particle(position.0, velocity.0, mass.0, pinned) {
@@ -47,8 +48,12 @@ pub fn gather(
             continue;
         }
         state.position[i] = position.0;
-        // A frozen particle stays where it is, whatever its velocity says.
-        state.velocity[i] = if frozen { DVec2::ZERO } else { velocity.0 };
+        // A pinned or frozen particle stays where it is, whatever its velocity says.
+        state.velocity[i] = if fixed || frozen {
+            DVec2::ZERO
+        } else {
+            velocity.0
+        };
         state.mass[i] = mass.0;
         state.inverse_mass[i] = if pinned { 0.0 } else { 1.0 / mass.0 };
         state.external_force[i] = match external {

@@ -17,7 +17,9 @@ use crate::model::validate::{StrandError, check_particle, check_strand_shape};
 use crate::model::{Bend, Edge, NO_ISLAND, bend_count};
 use crate::world::config::StrandsConfig;
 use crate::world::hooks::TopologyDirty;
-use crate::world::particle::{Frozen, Mass, Particle, Pinned, Position, SolverIndex, Velocity};
+use crate::world::particle::{
+    Frozen, Kinematic, Mass, Particle, Pinned, Position, SolverIndex, Velocity,
+};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
@@ -91,18 +93,20 @@ pub fn rebuild_topology(world: &mut World) {
     let default_material = world.resource::<StrandsConfig>().material;
     let mut problems = world.remove_resource::<InputProblems>().unwrap_or_default();
 
-    // Particles that can be simulated, and whether each is pinned (a frozen one is).
+    // Particles that can be simulated, and whether each has infinite mass (pinned,
+    // kinematic or frozen).
     let mut particles = world.query_filtered::<(
         Entity,
         &Position,
         &Velocity,
         &Mass,
         Has<Pinned>,
+        Has<Kinematic>,
         Has<Frozen>,
     ), With<Particle>>();
     let mut valid: EntityHashMap<bool> = EntityHashMap::default();
-    for (entity, position, velocity, mass, pinned, frozen) in particles.iter(world) {
-        let pinned = pinned || frozen;
+    for (entity, position, velocity, mass, pinned, kinematic, frozen) in particles.iter(world) {
+        let pinned = pinned || kinematic || frozen;
         match check_particle(position.0, velocity.0, mass.0, pinned) {
             Err(problem) => problems.report(entity, format!("particle left out: {problem}")),
             Ok(()) => {

@@ -1,7 +1,7 @@
 //! The spaghetti factory: an inlet that extrudes strands into the box.
 //!
 //! Every `interval` seconds a particle appears at the inlet moving at `velocity`; the
-//! newest `held` particles are pinned and driven at that velocity, as the inlet's
+//! newest `held` particles are kinematic, driven at that velocity, as the inlet's
 //! rollers would; every `particles_per_strand` particles finish a strand and the next
 //! particle starts a new one. A strand is spawned — and constrained — as soon as it
 //! has two particles.
@@ -9,7 +9,7 @@
 //! A factory whose inlet is blocked — an edge of another strand within two thicknesses
 //! of where the held particles are about to move — stops its rollers (the held particles
 //! stand still) and postpones its emissions by the time it stands, rather than pushing
-//! pinned particles, which nothing can stop, through the pile.
+//! kinematic particles, which nothing can stop, through the pile.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
@@ -145,7 +145,7 @@ pub fn run_spaghetti_factories(
             // The extrusion stands still: so does its schedule.
             factory.progress.next_emission += tick;
             factory.progress.blocked_ticks += 1;
-            // A strand's first particle, alone and pinned at the inlet, can be what
+            // A strand's first particle, alone and held at the inlet, can be what
             // holds up the tail that blocks it (a strand hooked on it hangs there for
             // ever while the rollers wait): it is withdrawn, and emitted again once
             // the inlet is clear. Taking a particle away crosses nothing.
@@ -250,7 +250,7 @@ fn emit(
         Position(position),
         Velocity(spec.velocity),
         Mass(spec.mass),
-        Pinned,
+        Kinematic,
     ));
     if let Some(strand) = progress.current_strand {
         particle.insert(StrandOf(strand));
@@ -293,7 +293,7 @@ fn emit(
     let keep = if done { 0 } else { spec.held };
     let release = progress.current.len().saturating_sub(keep);
     for &p in &progress.current[..release] {
-        commands.entity(p).remove::<Pinned>();
+        commands.entity(p).remove::<Kinematic>();
     }
     if done {
         progress.current.clear();
