@@ -34,6 +34,7 @@
 
 #![warn(missing_docs)]
 
+pub mod anchors;
 pub mod collision;
 pub mod constraints;
 pub mod contact_loop;
@@ -71,6 +72,7 @@ use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_
 
 /// Everything most users need.
 pub mod prelude {
+    pub use crate::anchors::Anchor;
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
     pub use crate::guard::{FiniteGuard, NonFiniteState};
@@ -155,6 +157,7 @@ impl PluginGroup for StrandsPlugin {
             .add(CollisionPlugin)
             .add(ContactLoopPlugin)
             .add(transforms::TransformSyncPlugin)
+            .add(anchors::AnchorPlugin)
     }
 }
 

@@ -225,3 +225,45 @@ fn a_pixel_world_with_its_length_unit_moves_as_the_metre_world_scaled() {
     let error = |app: &App| app.world().resource::<StrandMetrics>().max_rel_length_error;
     assert!(error(&metres) < 1e-9 && error(&pixels) < 1e-9);
 }
+
+#[test]
+fn an_anchored_particle_follows_its_entity_and_the_rope_stays_exact() {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        bevy::transform::TransformPlugin,
+        StrandsPlugin::manual(),
+    ));
+    let crane = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.5, 0.8, 0.0))
+        .id();
+    let rope = StrandBuilder::line(DVec2::new(0.6, 0.8), DVec2::X, 15, 0.02)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let hook = app.world().get::<Strand>(rope).unwrap().particles[0];
+    let offset = Vec2::new(0.1, 0.0);
+    app.world_mut().entity_mut(hook).insert(Anchor {
+        target: crane,
+        offset,
+    });
+    for k in 0..120 {
+        // The crane circles and turns.
+        let t = k as f32 / 60.0;
+        *app.world_mut().get_mut::<Transform>(crane).unwrap() =
+            Transform::from_xyz(0.5 + 0.1 * t.cos(), 0.8 + 0.1 * t.sin(), 0.0)
+                .with_rotation(Quat::from_rotation_z(t));
+        app.update();
+        app.world_mut().run_schedule(StrandsTick);
+        let target = app.world().get::<GlobalTransform>(crane).unwrap();
+        let point = target
+            .transform_point(offset.extend(0.0))
+            .truncate()
+            .as_dvec2();
+        let at = app.world().get::<Position>(hook).unwrap().0;
+        assert!(at.distance(point) < 1e-12, "tick {k}: {at} against {point}");
+    }
+    assert!(app.world().get::<Kinematic>(hook).is_some());
+    let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error < 1e-9, "{error:e}");
+}
