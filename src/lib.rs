@@ -35,6 +35,7 @@
 #![warn(missing_docs)]
 
 pub mod anchors;
+pub mod colliders;
 pub mod collision;
 pub mod constraints;
 pub mod contact_loop;
@@ -73,6 +74,7 @@ use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_
 /// Everything most users need.
 pub mod prelude {
     pub use crate::anchors::Anchor;
+    pub use crate::colliders::{ColliderShape, StrandCollider};
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
     pub use crate::guard::{FiniteGuard, NonFiniteState};
@@ -158,6 +160,7 @@ impl PluginGroup for StrandsPlugin {
             .add(ContactLoopPlugin)
             .add(transforms::TransformSyncPlugin)
             .add(anchors::AnchorPlugin)
+            .add(colliders::ColliderPlugin)
     }
 }
 

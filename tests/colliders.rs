@@ -1,0 +1,122 @@
+//! Colliders that are not strands: strands land on them, are pushed by them when they
+//! move, and never pass through them.
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy_strands::prelude::*;
+use bevy_strands_app::fixtures::*;
+
+/// A headless app with transform propagation (colliders follow `GlobalTransform`) and
+/// the crossing check at every step.
+fn app_with_transforms() -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        bevy::transform::TransformPlugin,
+        StrandsPlugin::manual(),
+    ));
+    app.world_mut().resource_mut::<CollisionConfig>().check_crossings = true;
+    app.world_mut().resource_mut::<StrandMetrics>().edge_crossings = Some(0);
+    set_step(&mut app, 1.0 / 600.0, 10);
+    app
+}
+
+fn particles(app: &App, strand: Entity) -> Vec<DVec2> {
+    strand_particles(app, strand)
+        .iter()
+        .map(|&p| position(app, p))
+        .collect()
+}
+
+#[test]
+fn a_rope_drapes_over_a_circle_and_never_enters_it() {
+    let mut app = app_with_transforms();
+    let centre = DVec2::new(0.5, 0.4);
+    let radius = 0.1;
+    app.world_mut().spawn((
+        Transform::from_translation(centre.as_vec2().extend(0.0)),
+        StrandCollider::new(ColliderShape::Circle {
+            radius: radius as f32,
+        }),
+    ));
+    let rope = StrandBuilder::line(DVec2::new(0.25, 0.6), DVec2::X, 26, 0.02)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let mut closest = f64::MAX;
+    for _ in 0..60 {
+        app.update();
+        tick(&mut app);
+        for p in particles(&app, rope) {
+            closest = closest.min(p.distance(centre));
+        }
+    }
+    // Landed on it (within a few thicknesses), never inside.
+    assert!(
+        closest > radius,
+        "{closest} inside the circle of radius {radius}"
+    );
+    assert!(
+        closest < radius + 0.02,
+        "never reached the circle: {closest}"
+    );
+    // Draped: the ends hang below the top of the circle.
+    let ends = particles(&app, rope);
+    assert!(ends[0].y < centre.y && ends[25].y < centre.y, "{ends:?}");
+    assert_eq!(crossings(&app), 0);
+    let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error < 1e-9, "{error:e}");
+}
+
+#[test]
+fn a_moving_box_pushes_a_hanging_rope_aside_without_passing_through_it() {
+    let mut app = app_with_transforms();
+    let rope = StrandBuilder::line(DVec2::new(0.5, 0.9), -DVec2::Y, 21, 0.02)
+        .pin_first()
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let paddle = app
+        .world_mut()
+        .spawn((
+            Transform::from_xyz(0.3, 0.65, 0.0),
+            StrandCollider::new(ColliderShape::Box {
+                half_size: Vec2::new(0.03, 0.1),
+            }),
+        ))
+        .id();
+    for k in 0..60 {
+        // The paddle sweeps right at 0.6 m/s, through where the rope hangs.
+        let x = 0.3 + 0.6 * k as f32 / 100.0;
+        app.world_mut()
+            .get_mut::<Transform>(paddle)
+            .unwrap()
+            .translation
+            .x = x;
+        app.update();
+        tick(&mut app);
+    }
+    let paddle_x = app.world().get::<Transform>(paddle).unwrap().translation.x as f64;
+    assert!(paddle_x > 0.6);
+    // The rope's middle is ahead of the paddle's leading face: pushed, not passed.
+    let rope_at = particles(&app, rope);
+    let middle = rope_at[12];
+    assert!(
+        middle.x > paddle_x + 0.03,
+        "{middle} behind the paddle at {paddle_x}"
+    );
+    assert_eq!(crossings(&app), 0);
+    let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error < 1e-9, "{error:e}");
+
+    // Removing the collider removes its outline.
+    app.world_mut()
+        .entity_mut(paddle)
+        .remove::<StrandCollider>();
+    tick(&mut app);
+    let walls = app
+        .world_mut()
+        .query::<&StrandKind>()
+        .iter(app.world())
+        .filter(|k| **k == StrandKind::Wall)
+        .count();
+    assert_eq!(walls, 0);
+}
