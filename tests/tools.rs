@@ -158,3 +158,56 @@ fn a_tether_drags_a_particle_towards_the_cursor() {
     );
     assert!(app.world().resource::<StrandMetrics>().max_rel_length_error < 1e-12);
 }
+
+#[test]
+fn cutting_an_edge_splits_an_open_strand_and_opens_a_loop() {
+    let mut app = app();
+    let rope = StrandBuilder::line(DVec2::new(0.2, 0.8), DVec2::X, 10, 0.03)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let ring = StrandBuilder::closed_loop((0..8).map(|k| {
+        DVec2::new(0.5, 0.4) + 0.1 * DVec2::from_angle(k as f64 * std::f64::consts::FRAC_PI_4)
+    }))
+    .spawn_in(app.world_mut())
+    .unwrap();
+    tick(&mut app);
+    let before = strand_particles(&app, rope);
+    assert_eq!(cut_edge(app.world_mut(), rope, 3), Ok(2));
+    assert_eq!(strand_particles(&app, rope), before[..4].to_vec());
+    assert_eq!(cut_edge(app.world_mut(), ring, 5), Ok(1));
+    let ring_strand = app.world().get::<Strand>(ring).unwrap().clone();
+    assert!(!ring_strand.closed && ring_strand.particles.len() == 8);
+    assert_eq!(
+        cut_edge(app.world_mut(), rope, 7),
+        Err(bevy_strands::world::edit::ToolError::NoSuchEdge(rope, 7))
+    );
+    // The last edge of the first piece leaves a lone particle: it goes loose.
+    assert_eq!(cut_edge(app.world_mut(), rope, 2), Ok(1));
+    assert!(app.world().get::<StrandOf>(before[3]).is_none());
+    ticks(&mut app, 20);
+    let topology = app.world().resource::<Topology>();
+    assert_eq!(topology.strands.len(), 3);
+    let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error < 1e-9, "{error:e}");
+}
+
+#[test]
+fn a_ray_meets_the_first_strand_in_its_way() {
+    let mut app = app();
+    let near = StrandBuilder::line(DVec2::new(0.4, 0.2), DVec2::Y, 10, 0.05)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    StrandBuilder::line(DVec2::new(0.7, 0.2), DVec2::Y, 10, 0.05)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    tick(&mut app);
+    let hit = ray_cast_strands(app.world(), DVec2::new(0.1, 0.33), DVec2::X, 2.0).unwrap();
+    assert_eq!(hit.strand, near);
+    assert_eq!(hit.edge, 2);
+    let x = position(&app, hit.particles[0]).x;
+    assert!((hit.hit.point.x - x).abs() < 1e-12 && (hit.hit.distance - (x - 0.1)).abs() < 1e-12);
+    assert!(ray_cast_strands(app.world(), DVec2::new(0.1, 0.33), -DVec2::X, 2.0).is_none());
+    let nearest = nearest_strand_edge(app.world(), DVec2::new(0.45, 0.5), 0.1).unwrap();
+    assert_eq!(nearest.strand, near);
+    assert!(nearest_strand_edge(app.world(), DVec2::new(0.55, 0.5), 0.1).is_none());
+}

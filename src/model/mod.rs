@@ -2,7 +2,8 @@
 //!
 //! Edges and bending elements between packed particles, the geometry every stage
 //! shares (turning angles, closest points, segment intersection), the linear motion of
-//! a step, the point–edge weights of a contact, disjoint sets, and the validation rules
+//! a step, the point–edge weights of a contact, ray casts and nearest-edge queries,
+//! disjoint sets, and the validation rules
 //! that every entry point (the builder, the topology rebuild, scene files) applies. Everything above
 //! (kernels, the ECS layer, systems) may use this module; it uses nothing of theirs.
 
@@ -10,6 +11,7 @@ pub mod edge;
 pub mod geometry;
 pub mod motion;
 pub mod point_edge;
+pub mod queries;
 pub mod union_find;
 pub mod validate;
 

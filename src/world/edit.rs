@@ -7,11 +7,13 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use thiserror::Error;
 
+use crate::model::queries::{EdgeHit, nearest_edge, ray_cast};
 use crate::model::validate::{StrandError, rest_lengths_of};
 use crate::world::builder::StrandBuilder;
 use crate::world::particle::{Particle, Pinned, Position, Velocity};
+use crate::world::state::ParticleState;
 use crate::world::strand::{Strand, StrandKind};
-use crate::world::topology::split_strand;
+use crate::world::topology::{Topology, cut_strand, split_strand};
 
 /// Why an editing operation did nothing.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -22,6 +24,9 @@ pub enum ToolError {
     /// An edge needs two different particles.
     #[error("an edge needs two different particles")]
     SameParticle,
+    /// The strand has no such edge (or is not a strand).
+    #[error("{0} has no edge {1}")]
+    NoSuchEdge(Entity, usize),
     /// The two particles are already joined by an edge.
     #[error("{0} and {1} are already joined by an edge")]
     AlreadyJoined(Entity, Entity),
@@ -193,6 +198,67 @@ pub fn toggle_pin(world: &mut World, particle: Entity) -> Result<bool, ToolError
         entity.insert((Pinned, Velocity(DVec2::ZERO)));
         Ok(true)
     }
+}
+
+/// A strand edge a query met.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StrandHit {
+    /// The strand.
+    pub strand: Entity,
+    /// The edge's number along it.
+    pub edge: usize,
+    /// The edge's two particles.
+    pub particles: [Entity; 2],
+    /// The point met, where along the edge (0 at its first particle), and the distance
+    /// (along the ray, or from the point).
+    pub hit: EdgeHit,
+}
+
+fn strand_hit(world: &World, hit: EdgeHit) -> Option<StrandHit> {
+    let topology = world.get_resource::<Topology>()?;
+    let state = world.get_resource::<ParticleState>()?;
+    let edge = topology.edges.get(hit.edge as usize)?;
+    let record = topology.strands.get(edge.strand as usize)?;
+    Some(StrandHit {
+        strand: record.entity,
+        edge: hit.edge as usize - record.edges.start,
+        particles: [state.entity[edge.a as usize], state.entity[edge.b as usize]],
+        hit,
+    })
+}
+
+/// The first strand edge the ray from `origin` along `direction` meets within
+/// `max_distance` (a grappling hook's line), at the last tick's positions.
+pub fn ray_cast_strands(
+    world: &World,
+    origin: DVec2,
+    direction: DVec2,
+    max_distance: f64,
+) -> Option<StrandHit> {
+    let topology = world.get_resource::<Topology>()?;
+    let state = world.get_resource::<ParticleState>()?;
+    let hit = ray_cast(
+        &topology.edges,
+        &state.position,
+        origin,
+        direction,
+        max_distance,
+    )?;
+    strand_hit(world, hit)
+}
+
+/// The strand edge nearest `point` within `within`, at the last tick's positions.
+pub fn nearest_strand_edge(world: &World, point: DVec2, within: f64) -> Option<StrandHit> {
+    let topology = world.get_resource::<Topology>()?;
+    let state = world.get_resource::<ParticleState>()?;
+    let hit = nearest_edge(&topology.edges, &state.position, point, within)?;
+    strand_hit(world, hit)
+}
+
+/// Cut edge `edge` of `strand` at run time: an open strand becomes two (a piece of one
+/// particle leaves it loose), a loop opens. Returns the strands left.
+pub fn cut_edge(world: &mut World, strand: Entity, edge: usize) -> Result<usize, ToolError> {
+    cut_strand(world, strand, edge).ok_or(ToolError::NoSuchEdge(strand, edge))
 }
 
 /// Delete a particle. Every strand through it is split around it first, so that no

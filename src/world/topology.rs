@@ -333,21 +333,53 @@ pub fn split_strand(world: &mut World, entity: Entity, keep: impl Fn(Entity) -> 
     let Some(strand) = world.get::<Strand>(entity).cloned() else {
         return 0;
     };
+    let pieces = split_around(&strand, &keep);
+    replace_with_pieces(world, entity, &strand, pieces, keep)
+}
+
+/// Cut edge `edge` of strand `entity` (see [`cut_pieces`]). Returns the number of
+/// strands left, or `None` if there is no such strand or edge.
+pub fn cut_strand(world: &mut World, entity: Entity, edge: usize) -> Option<usize> {
+    let strand = world.get::<Strand>(entity)?.clone();
+    if edge >= strand.edge_count() {
+        return None;
+    }
+    let pieces = cut_pieces(&strand, edge);
+    Some(replace_with_pieces(world, entity, &strand, pieces, |_| {
+        true
+    }))
+}
+
+/// Put `pieces` in the place of strand `entity`: the first stays on `entity`, the
+/// others become new strands with its kind and material, owning their particles; with
+/// no piece the strand is despawned, and the particles it owned for which `keep`
+/// holds outlive it, loose.
+fn replace_with_pieces(
+    world: &mut World,
+    entity: Entity,
+    strand: &Strand,
+    pieces: Vec<Strand>,
+    keep: impl Fn(Entity) -> bool,
+) -> usize {
     let kind = world.get::<StrandKind>(entity).copied();
     let material = world.get::<StrandMaterial>(entity).copied();
-    let pieces = split_around(&strand, &keep);
     let owned_by = |world: &World, p: Entity| {
         world
             .get::<StrandOf>(p)
             .is_some_and(|owner| owner.0 == entity)
     };
-    let Some((first, rest)) = pieces.split_first() else {
-        // Nothing left to join: free the survivors so they outlive the strand.
-        for &p in &strand.particles {
-            if keep(p) && world.get_entity(p).is_ok() && owned_by(world, p) {
-                world.entity_mut(p).remove::<StrandOf>();
-            }
+    // Particles in no piece are freed first, so that despawning the strand (which
+    // takes the particles it owns) does not take them.
+    let in_pieces: Vec<Entity> = pieces
+        .iter()
+        .flat_map(|p| p.particles.iter().copied())
+        .collect();
+    for &p in &strand.particles {
+        if keep(p) && !in_pieces.contains(&p) && world.get_entity(p).is_ok() && owned_by(world, p) {
+            world.entity_mut(p).remove::<StrandOf>();
         }
+    }
+    let Some((first, rest)) = pieces.split_first() else {
         world.entity_mut(entity).despawn();
         return 0;
     };
@@ -379,36 +411,54 @@ pub fn split_around(strand: &Strand, keep: impl Fn(Entity) -> bool) -> Vec<Stran
     // the run that wraps around the end is not cut in two.
     let start = if strand.closed { gap + 1 } else { 0 };
     let walk: Vec<usize> = (0..n).map(|i| (start + i) % n).collect();
-    let angle_at = |v: usize| -> Option<f64> {
+    walk.split(|&v| !kept[v])
+        .filter(|run| run.len() >= 2)
+        .map(|run| piece(strand, run))
+        .collect()
+}
+
+/// The pieces of `strand` once its edge `edge` is cut: an open strand in two (a piece of
+/// one particle is left out; that particle is loose), a loop opened into one strand
+/// that starts after the cut.
+pub fn cut_pieces(strand: &Strand, edge: usize) -> Vec<Strand> {
+    let n = strand.particles.len();
+    let runs: Vec<Vec<usize>> = if strand.closed {
+        vec![(edge + 1..edge + 1 + n).map(|v| v % n).collect()]
+    } else {
+        vec![(0..=edge).collect(), (edge + 1..n).collect()]
+    };
+    runs.iter()
+        .filter(|run| run.len() >= 2)
+        .map(|run| piece(strand, run))
+        .collect()
+}
+
+/// The open strand through the vertices `run` of `strand` (consecutive along it), with
+/// their rest lengths and the rest angles of its interior vertices.
+fn piece(strand: &Strand, run: &[usize]) -> Strand {
+    let n = strand.particles.len();
+    let angle_at = |v: usize| -> f64 {
         if strand.rest_angles.is_empty() {
-            None
+            0.0
         } else if strand.closed {
-            Some(strand.rest_angles[v])
+            strand.rest_angles[v]
+        } else if v >= 1 && v + 1 < n {
+            strand.rest_angles[v - 1]
         } else {
-            (v >= 1 && v + 1 < n).then(|| strand.rest_angles[v - 1])
+            0.0
         }
     };
-    let mut pieces = Vec::new();
-    for run in walk.split(|&v| !kept[v]) {
-        if run.len() < 2 {
-            continue;
-        }
-        pieces.push(Strand {
-            particles: run.iter().map(|&v| strand.particles[v]).collect(),
-            // Edge (v, v + 1) has index v in both open and closed strands.
-            rest_lengths: run.windows(2).map(|w| strand.rest_lengths[w[0]]).collect(),
-            rest_angles: if strand.rest_angles.is_empty() {
-                Vec::new()
-            } else {
-                run[1..run.len() - 1]
-                    .iter()
-                    .map(|&v| angle_at(v).unwrap_or(0.0))
-                    .collect()
-            },
-            closed: false,
-        });
+    Strand {
+        particles: run.iter().map(|&v| strand.particles[v]).collect(),
+        // Edge (v, v + 1) has index v in both open and closed strands.
+        rest_lengths: run.windows(2).map(|w| strand.rest_lengths[w[0]]).collect(),
+        rest_angles: if strand.rest_angles.is_empty() {
+            Vec::new()
+        } else {
+            run[1..run.len() - 1].iter().map(|&v| angle_at(v)).collect()
+        },
+        closed: false,
     }
-    pieces
 }
 
 #[cfg(test)]
