@@ -38,6 +38,7 @@ pub mod anchors;
 pub mod colliders;
 pub mod collision;
 pub mod constraints;
+pub mod contact_events;
 pub mod contact_loop;
 pub mod forces;
 pub mod guard;
@@ -50,6 +51,7 @@ pub mod ribbon;
 pub mod schedule;
 pub mod snapshot;
 pub mod transforms;
+pub mod winch;
 pub mod world;
 
 use bevy::app::PluginGroupBuilder;
@@ -77,12 +79,14 @@ pub mod prelude {
     pub use crate::colliders::{ColliderShape, StrandCollider};
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
+    pub use crate::contact_events::StrandContact;
     pub use crate::guard::{FiniteGuard, NonFiniteState};
     pub use crate::metrics::StrandMetrics;
     pub use crate::schedule::{
         CollideSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
     };
     pub use crate::transforms::{SyncTransform, TickPositions};
+    pub use crate::winch::Winch;
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
@@ -161,6 +165,8 @@ impl PluginGroup for StrandsPlugin {
             .add(transforms::TransformSyncPlugin)
             .add(anchors::AnchorPlugin)
             .add(colliders::ColliderPlugin)
+            .add(contact_events::ContactEventsPlugin)
+            .add(winch::WinchPlugin)
     }
 }
 

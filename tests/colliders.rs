@@ -124,3 +124,57 @@ fn a_moving_box_pushes_a_hanging_rope_aside_without_passing_through_it() {
         .count();
     assert_eq!(walls, 0);
 }
+
+#[test]
+fn contact_messages_say_when_a_rope_lands_on_a_collider_and_leaves_it() {
+    let mut app = app_with_transforms();
+    let slab = app
+        .world_mut()
+        .spawn((
+            Transform::from_xyz(0.5, 0.3, 0.0),
+            StrandCollider::new(ColliderShape::Box {
+                half_size: Vec2::new(0.3, 0.02),
+            }),
+        ))
+        .id();
+    let rope = StrandBuilder::line(DVec2::new(0.35, 0.4), DVec2::X, 11, 0.03)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let mut seen = Vec::new();
+    let read = |app: &mut App, seen: &mut Vec<StrandContact>| {
+        let messages = app.world().resource::<Messages<StrandContact>>();
+        seen.extend(messages.iter_current_update_messages().copied());
+        app.world_mut()
+            .resource_mut::<Messages<StrandContact>>()
+            .update();
+    };
+    for _ in 0..40 {
+        app.update();
+        tick(&mut app);
+        read(&mut app, &mut seen);
+    }
+    let pair = (rope.min(slab), rope.max(slab));
+    eprintln!("SEEN {seen:?}");
+    assert_eq!(
+        seen.first(),
+        Some(&StrandContact::Started(pair.0, pair.1)),
+        "{seen:?}"
+    );
+    // Lifted well clear: the contact ends.
+    for p in strand_particles(&app, rope) {
+        let x = position(&app, p);
+        app.world_mut()
+            .entity_mut(p)
+            .insert((Position(x + DVec2::new(0.0, 0.5)), Velocity(DVec2::ZERO)));
+    }
+    for _ in 0..3 {
+        app.update();
+        tick(&mut app);
+        read(&mut app, &mut seen);
+    }
+    assert_eq!(
+        seen.last(),
+        Some(&StrandContact::Ended(pair.0, pair.1)),
+        "{seen:?}"
+    );
+}

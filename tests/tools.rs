@@ -211,3 +211,43 @@ fn a_ray_meets_the_first_strand_in_its_way() {
     assert_eq!(nearest.strand, near);
     assert!(nearest_strand_edge(app.world(), DVec2::new(0.55, 0.5), 0.1).is_none());
 }
+
+#[test]
+fn a_winch_reels_a_hanging_rope_in_and_pays_it_out_keeping_it_exact() {
+    for speed in [-0.1, 0.1] {
+        let mut app = app();
+        let rope = StrandBuilder::line(DVec2::new(0.5, 0.9), -DVec2::Y, 21, 0.02)
+            .pin_first()
+            .spawn_in(app.world_mut())
+            .unwrap();
+        app.world_mut().entity_mut(rope).insert(Winch {
+            speed,
+            spacing: 0.02,
+            min_length: 0.1,
+            max_length: 0.8,
+        });
+        tick(&mut app);
+        let length =
+            |app: &App| bevy_strands::winch::rope_length(app.world().get::<Strand>(rope).unwrap());
+        let start = length(&app);
+        ticks(&mut app, 200);
+        // 200 ticks of 6 × 1/600 s: 0.2 m in or out.
+        assert!(
+            (length(&app) - start - 2.0 * speed).abs() < 1e-9,
+            "{} from {start}",
+            length(&app)
+        );
+        let particles = strand_particles(&app, rope).len();
+        // One particle per 0.02 m: ten more or ten fewer.
+        assert_eq!(particles as i64, 21 + (speed / 0.01).round() as i64);
+        let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+        assert!(error < 1e-9, "{speed}: {error:e}");
+        // The rope hangs from its pin: its lowest particle is about a length below.
+        let tip = position(&app, *strand_particles(&app, rope).last().unwrap());
+        assert!(
+            (0.9 - tip.y - length(&app)).abs() < 0.05,
+            "{tip} for {}",
+            length(&app)
+        );
+    }
+}
