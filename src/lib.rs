@@ -50,6 +50,7 @@ pub mod render;
 pub mod ribbon;
 pub mod schedule;
 pub mod snapshot;
+pub mod tearing;
 pub mod transforms;
 pub mod winch;
 pub mod world;
@@ -85,6 +86,7 @@ pub mod prelude {
     pub use crate::schedule::{
         CollideSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
     };
+    pub use crate::tearing::{StrandTorn, Tearable};
     pub use crate::transforms::{SyncTransform, TickPositions};
     pub use crate::winch::Winch;
     pub use crate::world::builder::StrandBuilder;
@@ -167,6 +169,7 @@ impl PluginGroup for StrandsPlugin {
             .add(colliders::ColliderPlugin)
             .add(contact_events::ContactEventsPlugin)
             .add(winch::WinchPlugin)
+            .add(tearing::TearingPlugin)
     }
 }
 

@@ -481,3 +481,70 @@ fn a_heavy_bob_on_a_light_rope_swings_with_the_pendulum_period() {
     let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
     assert!(error < 1e-9, "{error:e}");
 }
+
+/// A rope hanging at rest: each edge's tension is the weight of the rope below it.
+#[test]
+fn a_hanging_ropes_tension_is_the_weight_below_each_edge() {
+    let mut app = app();
+    let dt = 1.0 / 600.0;
+    set_step(&mut app, dt, 1);
+    app.world_mut().resource_mut::<CollisionConfig>().enabled = false;
+    let n = 21;
+    let rope = StrandBuilder::line(DVec2::new(0.5, 0.9), -DVec2::Y, n, 0.02)
+        .mass(0.01)
+        .pin_first()
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    ticks(&mut app, 20);
+    let world = app.world();
+    let (islands, topology) = (world.resource::<Islands>(), world.resource::<Topology>());
+    let record = topology.strands.iter().find(|r| r.entity == rope).unwrap();
+    let g = 9.81;
+    for (k, edge) in record.edges.clone().enumerate() {
+        let below = (n - 1 - k) as f64 * 0.01 * g;
+        let tension = islands.edge_tension(edge, dt);
+        assert!(
+            (tension / below - 1.0).abs() < 1e-6,
+            "edge {k}: {tension} N against {below} N"
+        );
+    }
+}
+
+/// A rope that cannot hold its load tears where the tension passes its limit; one that
+/// can does not.
+#[test]
+fn a_tearable_rope_tears_under_a_load_past_its_limit() {
+    for (limit, tears) in [(5.0, true), (20.0, false)] {
+        let mut app = app();
+        set_step(&mut app, 1.0 / 600.0, 2);
+        let rope = StrandBuilder::line(DVec2::new(0.5, 0.9), -DVec2::Y, 11, 0.02)
+            .mass(0.01)
+            .pin_first()
+            .spawn_in(app.world_mut())
+            .unwrap();
+        let bob = *strand_particles(&app, rope).last().unwrap();
+        app.world_mut().entity_mut(bob).insert(Mass(1.0));
+        app.world_mut()
+            .entity_mut(rope)
+            .insert(Tearable { max_tension: limit });
+        let top = strand_particles(&app, rope)[0];
+        ticks(&mut app, 60);
+        // Torn once, at the top (the most tensioned edge): the rope falls away whole,
+        // leaving its pinned end behind.
+        let still_hung = strand_particles(&app, rope).contains(&top);
+        let fell = position(&app, bob).y < 0.7 - 0.05;
+        assert_eq!((still_hung, fell), (!tears, tears), "limit {limit} N");
+        assert_eq!(app.world().resource::<Topology>().strands.len(), 1);
+        assert_eq!(
+            strand_particles(&app, rope).len(),
+            if tears { 10 } else { 11 }
+        );
+        let messages = app.world().resource::<Messages<StrandTorn>>();
+        let torn: Vec<&StrandTorn> = messages.iter_current_update_messages().collect();
+        assert_eq!(!torn.is_empty(), tears);
+        for t in torn {
+            assert!(t.tension > limit && t.strand == rope);
+        }
+    }
+}

@@ -43,6 +43,9 @@ pub struct Islands {
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
     lanes: Vec<Lane>,
+    /// Each topology edge's impulse this step, summed over every projection of the
+    /// step (mass × length, tension positive): see [`Islands::edge_tension`].
+    impulse: Vec<f64>,
 }
 
 /// Below this many edges in all the Constrain stage stays on one thread: starting
@@ -54,6 +57,7 @@ const PARALLEL_EDGES: usize = 4096;
 #[derive(Debug, Default)]
 struct Lane {
     velocity: Vec<DVec2>,
+    impulse: Vec<f64>,
     scratch: IslandScratch,
     stats: IterationStats,
     /// Its slots of `Islands::solved`.
@@ -77,10 +81,6 @@ impl Islands {
         let is_path = |i: u32| self.set.islands[i as usize].kind == IslandKind::Path;
         let mut rest = free.filter(|&i| i != first).peekable();
         rest.peek().is_none() || (is_path(first) && rest.all(is_path))
-    }
-
-    fn view(&self, island: usize) -> IslandView<'_> {
-        island_view(&self.set, island)
     }
 
     /// Project every solved island (the Constrain stage), recording each solve.
@@ -113,6 +113,7 @@ impl Islands {
             solved,
             scratch,
             lanes,
+            impulse,
             ..
         } = self;
         lanes.resize_with(threads - 1, Lane::default);
@@ -135,6 +136,8 @@ impl Islands {
         for lane in lanes.iter_mut() {
             lane.velocity.clear();
             lane.velocity.extend_from_slice(bodies.velocity);
+            lane.impulse.clear();
+            lane.impulse.resize(impulse.len(), 0.0);
             lane.stats = IterationStats::default();
         }
         let (set, solved) = (&*set, &*solved);
@@ -152,13 +155,14 @@ impl Islands {
                             settings,
                             &mut lane.scratch,
                             &mut lane.stats,
+                            &mut lane.impulse,
                         );
                     }
                 });
             }
             for slot in first {
                 let view = island_view(set, solved[slot]);
-                project_met(view, bodies, &[], dt, settings, scratch, stats);
+                project_met(view, bodies, &[], dt, settings, scratch, stats, impulse);
             }
         });
         // Each lane's islands' velocities back; a pinned particle two islands share is
@@ -168,6 +172,9 @@ impl Islands {
                 for e in &set.edges[set.islands[solved[slot]].edges.clone()] {
                     for j in [e.a as usize, e.b as usize] {
                         bodies.velocity[j] = lane.velocity[j];
+                    }
+                    if e.edge != IslandEdge::GAP {
+                        impulse[e.edge as usize] += lane.impulse[e.edge as usize];
                     }
                 }
             }
@@ -409,6 +416,7 @@ impl Islands {
             settings,
             &mut self.scratch,
             stats,
+            &mut self.impulse,
         )
     }
 
@@ -421,11 +429,29 @@ impl Islands {
         settings: &ProjectionSettings,
         stats: &mut IterationStats,
     ) -> bool {
-        let mut scratch = std::mem::take(&mut self.scratch);
-        let view = self.view(island);
-        let met = project_met(view, bodies, contacts, dt, settings, &mut scratch, stats);
-        self.scratch = scratch;
-        met
+        let Islands {
+            set,
+            scratch,
+            impulse,
+            ..
+        } = self;
+        let view = island_view(set, island);
+        project_met(
+            view, bodies, contacts, dt, settings, scratch, stats, impulse,
+        )
+    }
+
+    /// Forget the last step's impulses (sized to the topology at its rebuild).
+    pub fn begin_step(&mut self) {
+        self.impulse.fill(0.0);
+    }
+
+    /// The tension of topology edge `edge` in the last step of `dt` (force; positive
+    /// when the edge pulls its particles together, negative when it pushes them
+    /// apart): the impulses of every projection of the step over dt². Zero for an edge
+    /// no projection solved (a spring, a rigid zone's, a static one).
+    pub fn edge_tension(&self, edge: usize, dt: f64) -> f64 {
+        self.impulse.get(edge).map_or(0.0, |j| j / (dt * dt))
     }
 }
 
@@ -445,7 +471,9 @@ fn island_view(set: &IslandSet, island: usize) -> IslandView<'_> {
     }
 }
 
-/// Project `view`, record the solve, and tell whether it met its edges.
+/// Project `view`, record the solve and its edges' impulses (into `impulse`, by
+/// topology edge), and tell whether it met its edges.
+#[allow(clippy::too_many_arguments)]
 fn project_met(
     view: IslandView,
     bodies: &mut Bodies,
@@ -454,8 +482,17 @@ fn project_met(
     settings: &ProjectionSettings,
     scratch: &mut IslandScratch,
     stats: &mut IterationStats,
+    impulse: &mut [f64],
 ) -> bool {
+    let edges = match view {
+        IslandView::Chain(Chain { edges, .. }) | IslandView::Graph(Graph { edges, .. }) => edges,
+    };
     let outcome = project_island(view, bodies.reborrow(), contacts, dt, settings, scratch);
+    for (e, j) in edges.iter().zip(scratch.edge_impulses(edges.len())) {
+        if let Some(slot) = impulse.get_mut(e.edge as usize) {
+            *slot += j;
+        }
+    }
     stats.record(&outcome);
     outcome.converged && !outcome.rejected && !outcome.singular
 }
@@ -567,6 +604,8 @@ pub fn rebuild_islands(
     islands.solved = solved;
     islands.unsolved = unsolved;
     islands.version = topology.version;
+    islands.impulse.clear();
+    islands.impulse.resize(topology.edges.len(), 0.0);
 }
 
 /// The Constrain stage: project every solved island.
@@ -585,6 +624,7 @@ pub fn solve_constraints(
     } = &mut *state;
     let mut bodies = Bodies::new(position, velocity, inverse_mass);
     let settings = config.projection();
+    islands.begin_step();
     match config.solver.relaxation() {
         Some(method) => islands.relax(
             method,

@@ -76,6 +76,7 @@ pub(super) fn project_walk<W: Walk>(
             break;
         }
         scratch.correction[..particles].fill(DVec2::ZERO);
+        scratch.edge_impulse[..m].fill(0.0);
         scratch.exact_contacts = exact;
         localize_contacts(contacts, particles, &particle, velocity, dt, scratch);
         outcome = iterate(edges, walk, shortest, settings, scratch);
@@ -89,6 +90,7 @@ pub(super) fn project_walk<W: Walk>(
     }
     if outcome.rejected {
         outcome.converged = false;
+        scratch.edge_impulse[..m].fill(0.0);
         return outcome;
     }
     let correction = &scratch.correction[..particles];
@@ -203,6 +205,7 @@ fn newton_step<W: Walk>(
     };
     for (k, d) in direction.iter().enumerate() {
         let impulse = 2.0 * s.rhs[k] * *d;
+        s.step_impulse[k] = -2.0 * s.rhs[k] * d.length();
         let (a, b) = walk.ends(k, particles);
         s.correction[a] -= s.inverse_mass[a] * impulse;
         s.correction[b] += s.inverse_mass[b] * impulse;
@@ -213,6 +216,7 @@ fn newton_step<W: Walk>(
             s.correction[j as usize] += s.inverse_mass[j as usize] * coefficient * mu * row.normal;
         }
     }
+    let mut shrink = 1.0;
     if rows > 0 {
         let (start, correction) = (&s.step_start[..particles], &mut s.correction[..particles]);
         let longest = start
@@ -221,11 +225,14 @@ fn newton_step<W: Walk>(
             .map(|(a, b)| (*b - *a).length())
             .fold(0.0f64, f64::max);
         if longest > trust {
-            let shrink = trust / longest;
+            shrink = trust / longest;
             for (a, b) in start.iter().zip(correction.iter_mut()) {
                 *b = *a + shrink * (*b - *a);
             }
         }
+    }
+    for k in 0..m {
+        s.edge_impulse[k] += shrink * s.step_impulse[k];
     }
     Ok(())
 }

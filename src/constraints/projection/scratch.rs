@@ -39,6 +39,11 @@ pub struct IslandScratch {
     pub(super) upper: Vec<f64>,
     pub(super) rhs: Vec<f64>,
     pub(super) thomas: Vec<f64>,
+    /// Each edge's impulse this projection (mass × length, tension positive): the sum of
+    /// its Newton steps' `−2 λ |d|`.
+    pub(super) edge_impulse: Vec<f64>,
+    /// The current Newton step's share of `edge_impulse`, before any trust shrink.
+    pub(super) step_impulse: Vec<f64>,
     pub(super) factors: Factors,
     pub(super) local_of: Vec<u32>,
     pub(super) rows: Vec<LocalRow>,
@@ -75,9 +80,17 @@ impl IslandScratch {
             &mut self.upper,
             &mut self.rhs,
             &mut self.thomas,
+            &mut self.edge_impulse,
+            &mut self.step_impulse,
         ] {
             grow(buffer, edges, 0.0);
         }
+    }
+
+    /// The impulse each of the last projected island's `edges` edges carried (mass ×
+    /// length; divided by dt² it is the edge's tension, positive when it pulls).
+    pub fn edge_impulses(&self, edges: usize) -> &[f64] {
+        &self.edge_impulse[..edges]
     }
 
     /// Make room for contact rows on islands of up to `edges` edges, at most `degree`
