@@ -11,6 +11,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::anchors::Anchor;
+use crate::model::validate::rest_lengths_of;
 use crate::schedule::{StrandsTick, TickSet};
 use crate::world::particle::{Particle, Position, Velocity};
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
@@ -169,20 +170,31 @@ fn build_outlines(
             warn!("bevy_strands: collider {entity} has too few points for an outline");
             continue;
         }
-        let world_point = |p: Vec2| {
-            transform
-                .transform_point(p.extend(0.0))
-                .truncate()
-                .as_dvec2()
+        let at: Vec<DVec2> = points
+            .iter()
+            .map(|&p| {
+                transform
+                    .transform_point(p.extend(0.0))
+                    .truncate()
+                    .as_dvec2()
+            })
+            .collect();
+        let rest_lengths = match rest_lengths_of(&at, closed) {
+            Ok(lengths) => lengths,
+            Err(problem) => {
+                warn!("bevy_strands: collider {entity} has no outline: {problem}");
+                continue;
+            }
         };
         let strand = commands.spawn_empty().id();
         let particles: Vec<Entity> = points
             .iter()
-            .map(|&p| {
+            .zip(&at)
+            .map(|(&p, &x)| {
                 commands
                     .spawn((
                         Particle,
-                        Position(world_point(p)),
+                        Position(x),
                         Velocity(DVec2::ZERO),
                         Anchor {
                             target: entity,
@@ -192,11 +204,6 @@ fn build_outlines(
                     ))
                     .id()
             })
-            .collect();
-        let at: Vec<DVec2> = points.iter().map(|&p| world_point(p)).collect();
-        let edges = if closed { at.len() } else { at.len() - 1 };
-        let rest_lengths = (0..edges)
-            .map(|k| at[k].distance(at[(k + 1) % at.len()]))
             .collect();
         commands.entity(strand).insert((
             Strand {

@@ -15,12 +15,7 @@ fn app_with_transforms() -> App {
         bevy::transform::TransformPlugin,
         StrandsPlugin::manual(),
     ));
-    app.world_mut()
-        .resource_mut::<CollisionConfig>()
-        .check_crossings = true;
-    app.world_mut()
-        .resource_mut::<StrandMetrics>()
-        .edge_crossings = Some(0);
+    check_crossings(&mut app);
     set_step(&mut app, 1.0 / 600.0, 10);
     app
 }

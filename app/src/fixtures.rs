@@ -22,13 +22,18 @@ pub fn app() -> App {
 /// A headless app with the crossing check on.
 pub fn checked_app() -> App {
     let mut app = app();
+    check_crossings(&mut app);
+    app
+}
+
+/// Turn the crossing check on, counting from now.
+pub fn check_crossings(app: &mut App) {
     app.world_mut()
         .resource_mut::<CollisionConfig>()
         .check_crossings = true;
     app.world_mut()
         .resource_mut::<StrandMetrics>()
         .edge_crossings = Some(0);
-    app
 }
 
 /// Configure the step.
