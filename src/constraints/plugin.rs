@@ -263,6 +263,7 @@ impl Islands {
             .map(|row| row.target - row.normal_velocity(bodies.velocity))
             .fold(0.0, f64::max);
         for _ in 0..sweeps {
+            let mut all_met = true;
             let mut start = 0;
             while start < self.members.len() {
                 let unit = self.members[start].0;
@@ -303,6 +304,7 @@ impl Islands {
                 } else {
                     self.project_group(start..end, bodies, &rows, dt, settings, stats)
                 };
+                all_met &= met;
                 for &(_, member) in &self.members[start..end] {
                     match outcomes.iter_mut().find(|(i, _)| *i == member) {
                         Some(outcome) => outcome.1 = met,
@@ -317,8 +319,10 @@ impl Islands {
                 .map(|row| row.target - row.normal_velocity(bodies.velocity))
                 .fold(0.0, f64::max);
             // Each unit met its own contacts exactly; only contacts between units can
-            // have been disturbed since.
-            if !crosses_units || shortfall <= tolerance {
+            // have been disturbed since. A unit that could not meet its rows against
+            // the others' motion may meet them once the others have moved (a heavy
+            // body stopped on a taut rope): it is tried again.
+            if all_met && (!crosses_units || shortfall <= tolerance) {
                 break;
             }
         }
