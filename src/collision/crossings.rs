@@ -32,7 +32,9 @@ pub fn count_crossings(
     broad.build(edges, position, None, 0.0);
     let crossed = |j: u32, k: u32| {
         let (e, f) = (&edges[j as usize], &edges[k as usize]);
-        !e.shares_particle(f)
+        // Walls' and bodies' edges never meet each other (see `Edge::solid`).
+        let apart = e.shares_particle(f) || (e.solid && f.solid);
+        !apart
             && segments_intersect(
                 position[e.a as usize],
                 position[e.b as usize],

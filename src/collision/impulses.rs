@@ -150,6 +150,8 @@ pub struct Collider<'a> {
     /// The rigid group (constraint island) of each particle: a fail-safe zone takes in
     /// whole groups.
     pub groups: &'a [u32],
+    /// Whether each particle is a wall's or a body's (see [`Edge::solid`]).
+    pub solid: &'a [bool],
     /// Set for every free particle that takes part in a contact.
     pub in_contact: &'a mut [bool],
     /// The settings.
@@ -172,12 +174,13 @@ impl Collider<'_> {
             self.settings.thickness,
         );
         scratch.pairs.clear();
-        let (edges, w) = (self.edges, self.inverse_mass);
+        let (edges, w, solid) = (self.edges, self.inverse_mass, self.solid);
         let keep = |p: u32, k: u32| {
             let e = &edges[k as usize];
             e.a != p
                 && e.b != p
                 && (w[p as usize] > 0.0 || w[e.a as usize] > 0.0 || w[e.b as usize] > 0.0)
+                && !(e.solid && solid.get(p as usize).copied().unwrap_or(false))
         };
         scratch.broad.point_edge_pairs(
             self.settings.broad_phase,

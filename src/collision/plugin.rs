@@ -83,6 +83,7 @@ pub fn collider<'a>(
         mass,
         inverse_mass,
         groups: &topology.island,
+        solid: &topology.solid,
         in_contact,
         settings,
         dt,

@@ -23,6 +23,9 @@ pub struct Edge {
     pub stiffness: f64,
     /// Stretch spring damping along the edge.
     pub damping: f64,
+    /// An edge of a wall or a collider's body: it meets strands, never another wall's
+    /// particles (bodies meet each other in their own physics, walls never move).
+    pub solid: bool,
 }
 
 impl Edge {
@@ -38,6 +41,7 @@ impl Edge {
             spring: false,
             stiffness: 0.0,
             damping: 0.0,
+            solid: false,
         }
     }
 

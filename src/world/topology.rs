@@ -46,6 +46,9 @@ pub struct Topology {
     pub index: EntityHashMap<u32>,
     /// Whether each packed particle is pinned.
     pub pinned: Vec<bool>,
+    /// Whether each packed particle is a vertex of a wall or a collider's body (a
+    /// `StrandKind::Wall` strand): such a point never meets another wall's edges.
+    pub solid: Vec<bool>,
     /// The solved constraint island of each packed particle, [`NO_ISLAND`] for none;
     /// set by the constraint plugin after each rebuild. A collision fail-safe zone
     /// takes in whole islands.
@@ -220,6 +223,7 @@ pub fn rebuild_topology(world: &mut World) {
                 spring: !is_static && material.stretch_stiffness > 0.0,
                 stiffness: material.stretch_stiffness,
                 damping: material.stretch_damping,
+                solid: *kind == StrandKind::Wall,
             });
         }
         let bendable = material.bending_stiffness > 0.0 || material.bending_damping > 0.0;
@@ -263,6 +267,11 @@ pub fn rebuild_topology(world: &mut World) {
     }
     let pinned: Vec<bool> = order.iter().map(|e| valid[e]).collect();
     let topology_len = pinned.len();
+    let mut solid = vec![false; topology_len];
+    for e in edges.iter().filter(|e| e.solid) {
+        solid[e.a as usize] = true;
+        solid[e.b as usize] = true;
+    }
     world.resource_mut::<ParticleState>().resize(order);
     world.insert_resource(problems);
 
@@ -272,6 +281,7 @@ pub fn rebuild_topology(world: &mut World) {
     topology.island.clear();
     topology.island.resize(topology_len, NO_ISLAND);
     topology.pinned = pinned;
+    topology.solid = solid;
     topology.edges = edges;
     topology.bends = bends;
     topology.strands = records;
