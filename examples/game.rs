@@ -87,7 +87,7 @@ fn setup(
         texture: Some(rope_texture),
         ..default()
     });
-    let bridge = sagging_rope(DVec2::new(0.3, 0.7), DVec2::new(1.1, 0.7), 40, 1.08);
+    let bridge = StrandBuilder::hanging(DVec2::new(0.3, 0.7), DVec2::new(1.1, 0.7), 40, 1.08);
     let bridge = bridge.spawn(&mut commands).expect("a valid rope");
     commands.entity(bridge).insert((
         StrandRibbon {
@@ -181,19 +181,6 @@ fn wall(commands: &mut Commands, a: DVec2, b: DVec2) {
         .material(StrandMaterial::INERT)
         .spawn(commands)
         .expect("a valid wall");
-}
-
-/// `n` particles from `a` to `b`, pinned at both, `slack` times longer than the gap:
-/// laid on a parabola of that length.
-fn sagging_rope(a: DVec2, b: DVec2, n: usize, slack: f64) -> StrandBuilder {
-    let span = a.distance(b);
-    // A parabola of depth d has length ≈ span (1 + 8 d² / (3 span²)).
-    let depth = span * ((slack - 1.0) * 3.0 / 8.0).sqrt();
-    let points = (0..n).map(|i| {
-        let t = i as f64 / (n - 1) as f64;
-        a.lerp(b, t) - DVec2::Y * 4.0 * depth * t * (1.0 - t)
-    });
-    StrandBuilder::polyline(points).pin(0).pin(n - 1)
 }
 
 /// A twisted-rope texture: diagonal bands of two browns, repeating in both directions.

@@ -76,6 +76,22 @@ impl StrandBuilder {
         Self::polyline((0..count).map(move |i| start + step * i as f64))
     }
 
+    /// A rope hung between `a` and `b`, pinned at both: `count` particles on a parabola
+    /// `slack` times as long as the gap (a rope bridge, a washing line).
+    pub fn hanging(a: DVec2, b: DVec2, count: usize, slack: f64) -> Self {
+        let count = count.clamp(2, MAX_STRAND_PARTICLES + 1);
+        let span = a.distance(b);
+        // A parabola of depth d is about span (1 + 8 d² / (3 span²)) long.
+        let depth = span * ((slack.max(1.0) - 1.0) * 3.0 / 8.0).sqrt();
+        let last = (count - 1) as f64;
+        Self::polyline((0..count).map(move |i| {
+            let t = i as f64 / last;
+            a.lerp(b, t) - DVec2::Y * 4.0 * depth * t * (1.0 - t)
+        }))
+        .pin(0)
+        .pin(count - 1)
+    }
+
     /// A closed loop through the given points (the last joins the first), keeping their
     /// shape at rest.
     pub fn closed_loop(points: impl IntoIterator<Item = DVec2>) -> Self {
