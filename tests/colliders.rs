@@ -173,3 +173,38 @@ fn contact_messages_say_when_a_rope_lands_on_a_collider_and_leaves_it() {
         "{seen:?}"
     );
 }
+
+/// Colliders that overlap each other (a box half inside a circle) are not crossed
+/// edges, and a rope dropped across both still lands on their outer outline.
+#[test]
+fn overlapping_colliders_are_not_crossings_and_still_hold_a_rope() {
+    let mut app = app_with_transforms();
+    let centre = DVec2::new(0.5, 0.4);
+    app.world_mut().spawn((
+        Transform::from_translation(centre.as_vec2().extend(0.0)),
+        StrandCollider::new(ColliderShape::Circle { radius: 0.1 }),
+    ));
+    app.world_mut().spawn((
+        Transform::from_xyz(0.6, 0.45, 0.0),
+        StrandCollider::new(ColliderShape::Box {
+            half_size: Vec2::new(0.08, 0.05),
+        }),
+    ));
+    let rope = StrandBuilder::line(DVec2::new(0.3, 0.65), DVec2::X, 26, 0.02)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    for _ in 0..60 {
+        app.update();
+        tick(&mut app);
+    }
+    assert_eq!(crossings(&app), 0);
+    // Resting on top: above the circle and the box.
+    let lowest_over_both = particles(&app, rope)
+        .into_iter()
+        .filter(|p| (0.45..0.65).contains(&p.x))
+        .map(|p| p.y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(lowest_over_both > 0.49, "{lowest_over_both}");
+    let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+    assert!(error < 1e-9, "{error:e}");
+}
