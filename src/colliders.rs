@@ -75,6 +75,11 @@ pub struct ColliderOf(pub Entity);
 #[reflect(Component)]
 pub struct ColliderStrand(pub Entity);
 
+/// Where new outlines are built in the tick: a coupling that builds its own outlines
+/// (the avian one) runs before it, so that each collider gets one.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct OutlineBuild;
+
 /// Builds and removes the collider outlines.
 pub struct ColliderPlugin;
 
@@ -85,7 +90,7 @@ impl Plugin for ColliderPlugin {
             .register_type::<ColliderStrand>()
             .add_systems(
                 StrandsTick,
-                (remove_orphan_outlines, build_outlines)
+                (remove_orphan_outlines, build_outlines.in_set(OutlineBuild))
                     .chain()
                     .before(TickSet::Topology),
             );
@@ -166,58 +171,74 @@ fn build_outlines(
 ) {
     for (entity, collider, transform) in &colliders {
         let (points, closed) = outline(&collider.shape, collider.tolerance);
-        if points.len() < if closed { 3 } else { 2 } {
-            warn!("bevy_strands: collider {entity} has too few points for an outline");
-            continue;
-        }
-        let at: Vec<DVec2> = points
-            .iter()
-            .map(|&p| {
-                transform
-                    .transform_point(p.extend(0.0))
-                    .truncate()
-                    .as_dvec2()
-            })
-            .collect();
-        let rest_lengths = match rest_lengths_of(&at, closed) {
-            Ok(lengths) => lengths,
-            Err(problem) => {
-                warn!("bevy_strands: collider {entity} has no outline: {problem}");
-                continue;
-            }
+        let world_point = |p: Vec2| {
+            transform
+                .transform_point(p.extend(0.0))
+                .truncate()
+                .as_dvec2()
         };
-        let strand = commands.spawn_empty().id();
-        let particles: Vec<Entity> = points
-            .iter()
-            .zip(&at)
-            .map(|(&p, &x)| {
-                commands
-                    .spawn((
-                        Particle,
-                        Position(x),
-                        Velocity(DVec2::ZERO),
-                        Anchor {
-                            target: entity,
-                            offset: p,
-                        },
-                        StrandOf(strand),
-                    ))
-                    .id()
-            })
-            .collect();
-        commands.entity(strand).insert((
-            Strand {
-                particles,
-                rest_lengths,
-                rest_angles: Vec::new(),
-                closed,
-            },
-            StrandKind::Wall,
-            StrandMaterial::INERT,
-            ColliderOf(entity),
-        ));
-        commands.entity(entity).insert(ColliderStrand(strand));
+        spawn_outline(&mut commands, entity, &points, closed, world_point, |p| {
+            Anchor {
+                target: entity,
+                offset: p,
+            }
+        });
     }
+}
+
+/// Spawn the wall strand outlining `collider`: one particle per vertex of `points`
+/// (in the collider's frame) at `world_point(p)`, each given `attach(p)` to follow the
+/// collider. Refused, with a warning, for too few or coincident points. Returns the
+/// strand and its particles.
+pub(crate) fn spawn_outline<B: Bundle>(
+    commands: &mut Commands,
+    collider: Entity,
+    points: &[Vec2],
+    closed: bool,
+    world_point: impl Fn(Vec2) -> DVec2,
+    attach: impl Fn(Vec2) -> B,
+) -> Option<(Entity, Vec<Entity>)> {
+    if points.len() < if closed { 3 } else { 2 } {
+        warn!("bevy_strands: collider {collider} has too few points for an outline");
+        return None;
+    }
+    let at: Vec<DVec2> = points.iter().map(|&p| world_point(p)).collect();
+    let rest_lengths = match rest_lengths_of(&at, closed) {
+        Ok(lengths) => lengths,
+        Err(problem) => {
+            warn!("bevy_strands: collider {collider} has no outline: {problem}");
+            return None;
+        }
+    };
+    let strand = commands.spawn_empty().id();
+    let particles: Vec<Entity> = points
+        .iter()
+        .zip(&at)
+        .map(|(&p, &x)| {
+            commands
+                .spawn((
+                    Particle,
+                    Position(x),
+                    Velocity(DVec2::ZERO),
+                    attach(p),
+                    StrandOf(strand),
+                ))
+                .id()
+        })
+        .collect();
+    commands.entity(strand).insert((
+        Strand {
+            particles: particles.clone(),
+            rest_lengths,
+            rest_angles: Vec::new(),
+            closed,
+        },
+        StrandKind::Wall,
+        StrandMaterial::INERT,
+        ColliderOf(collider),
+    ));
+    commands.entity(collider).insert(ColliderStrand(strand));
+    Some((strand, particles))
 }
 
 /// An outline whose collider is gone (or no longer a collider) goes too.

@@ -35,6 +35,8 @@
 #![warn(missing_docs)]
 
 pub mod anchors;
+#[cfg(feature = "avian")]
+pub mod avian;
 pub mod colliders;
 pub mod collision;
 pub mod constraints;
@@ -77,6 +79,8 @@ use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_
 /// Everything most users need.
 pub mod prelude {
     pub use crate::anchors::Anchor;
+    #[cfg(feature = "avian")]
+    pub use crate::avian::{BodyAnchor, CollidesWithStrands, StrandsAvianPlugin};
     pub use crate::colliders::{ColliderShape, StrandCollider};
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
