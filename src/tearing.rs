@@ -8,6 +8,7 @@ use bevy::prelude::*;
 use crate::constraints::Islands;
 use crate::schedule::{StrandsTick, TickSet, stepping};
 use crate::world::config::StrandsConfig;
+use crate::world::strand::{Strand, StrandOf};
 use crate::world::topology::{Topology, cut_strand};
 
 /// Cut this strand's edges that pull harder than `max_tension` (newtons).
@@ -67,8 +68,18 @@ fn tear(
                 edge,
                 tension,
             };
+            let limit = *tearable;
             commands.queue(move |world: &mut World| {
+                // The particle past the cut: a new piece owns it afterwards, and tears
+                // as the strand it came from.
+                let beyond = world
+                    .get::<Strand>(event.strand)
+                    .and_then(|s| s.particles.get(event.edge + 1).copied());
                 if cut_strand(world, event.strand, event.edge).is_some() {
+                    let piece = beyond.and_then(|p| world.get::<StrandOf>(p)).map(|of| of.0);
+                    if let Some(piece) = piece.filter(|&piece| piece != event.strand) {
+                        world.entity_mut(piece).insert(limit);
+                    }
                     world.write_message(event);
                 }
             });

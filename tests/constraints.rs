@@ -548,3 +548,31 @@ fn a_tearable_rope_tears_under_a_load_past_its_limit() {
         }
     }
 }
+
+/// A span torn away from one end: the piece cut off tears as the strand it came from.
+#[test]
+fn a_torn_off_piece_stays_tearable() {
+    let mut app = app();
+    set_step(&mut app, 1.0 / 600.0, 2);
+    app.world_mut().resource_mut::<CollisionConfig>().enabled = false;
+    let rope = StrandBuilder::hanging(DVec2::new(0.2, 0.5), DVec2::new(0.8, 0.5), 11, 1.05)
+        .mass(0.01)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    app.world_mut()
+        .entity_mut(rope)
+        .insert(Tearable { max_tension: 10.0 });
+    // Pulled down near the right end: the short, steep side carries the most.
+    let particles = strand_particles(&app, rope);
+    app.world_mut()
+        .entity_mut(particles[7])
+        .insert(ExternalForce(DVec2::new(0.0, -30.0)));
+    ticks(&mut app, 30);
+    let of = |p: Entity| app.world().get::<StrandOf>(p).map(|of| of.0);
+    let piece = of(particles[9]).expect("the far piece is a strand");
+    assert_ne!(piece, rope, "not torn on the short side");
+    assert_eq!(
+        app.world().get::<Tearable>(piece),
+        Some(&Tearable { max_tension: 10.0 })
+    );
+}
