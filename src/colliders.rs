@@ -171,19 +171,31 @@ fn build_outlines(
 ) {
     for (entity, collider, transform) in &colliders {
         let (points, closed) = outline(&collider.shape, collider.tolerance);
-        let world_point = |p: Vec2| {
-            transform
-                .transform_point(p.extend(0.0))
-                .truncate()
-                .as_dvec2()
-        };
-        spawn_outline(&mut commands, entity, &points, closed, world_point, |p| {
-            Anchor {
-                target: entity,
-                offset: p,
-            }
-        });
+        spawn_anchored_outline(&mut commands, entity, &points, closed, transform);
     }
+}
+
+/// The outline of `points` (the collider's frame) placed by the collider's transform,
+/// its vertices [`Anchor`]ed to the collider entity.
+pub(crate) fn spawn_anchored_outline(
+    commands: &mut Commands,
+    collider: Entity,
+    points: &[Vec2],
+    closed: bool,
+    transform: &GlobalTransform,
+) {
+    let world_point = |p: Vec2| {
+        transform
+            .transform_point(p.extend(0.0))
+            .truncate()
+            .as_dvec2()
+    };
+    spawn_outline(commands, collider, points, closed, world_point, |p| {
+        Anchor {
+            target: collider,
+            offset: p,
+        }
+    });
 }
 
 /// Spawn the wall strand outlining `collider`: one particle per vertex of `points`

@@ -20,6 +20,7 @@ use avian2d::prelude::{
     LinearVelocity, RigidBody, Rotation, WriteRigidBodyForces,
 };
 
+use super::anchor::BodyAnchor;
 use super::shapes::effective_mass;
 use super::truss::{OutlineVertex, Rigged};
 use crate::world::config::{CollisionConfig, StrandsConfig};
@@ -27,19 +28,6 @@ use crate::world::particle::{Kinematic, Position, SolverIndex, Velocity};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::strand::{Strand, StrandOf};
-
-/// Attach this particle to an avian rigid body at `offset` in the body's frame. On a
-/// dynamic body both ways: the body's weight hangs on the strand and the strand's pull
-/// moves the body. On a static or kinematic body the particle follows it (and is made
-/// [`Kinematic`]).
-#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
-#[reflect(Component)]
-pub struct BodyAnchor {
-    /// The rigid body.
-    pub body: Entity,
-    /// Where on it, in the body's frame (about its origin, not its centre of mass).
-    pub offset: Vec2,
-}
 
 /// One particle coupled to a dynamic body this tick.
 #[derive(Clone, Copy, Debug)]

@@ -15,6 +15,7 @@
 //! from the bodies' new poses and velocities; the impulses it measures reach the bodies
 //! before avian's next step.
 
+pub mod anchor;
 pub mod coupling;
 pub mod shapes;
 pub mod truss;
@@ -25,14 +26,16 @@ use avian2d::prelude::{
     Collider, ComputedCenterOfMass, Gravity, PhysicsSystems, RigidBody, Rotation,
 };
 
-use crate::anchors::Anchor;
-use crate::colliders::{ColliderShape, OutlineBuild, StrandCollider, spawn_outline};
+use crate::colliders::{
+    ColliderShape, OutlineBuild, StrandCollider, spawn_anchored_outline, spawn_outline,
+};
 use crate::schedule::{
     CollideSet, ConstrainSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
 };
 use crate::world::config::StrandsConfig;
 use crate::world::particle::Kinematic;
-pub use coupling::{BodyAnchor, BodyCoupling};
+pub use anchor::BodyAnchor;
+pub use coupling::BodyCoupling;
 use truss::{OutlineVertex, spawn_truss};
 
 /// Make strands collide with this avian collider, its curves drawn within `tolerance`.
@@ -161,18 +164,7 @@ fn build_body_outlines(
         let Ok((body_position, body_rotation, body, centre_of_mass)) = bodies.get(body_entity)
         else {
             // No rigid body: a fixed shape where its transform puts it.
-            let world_point = |p: Vec2| {
-                transform
-                    .transform_point(p.extend(0.0))
-                    .truncate()
-                    .as_dvec2()
-            };
-            spawn_outline(&mut commands, entity, &points, closed, world_point, |p| {
-                Anchor {
-                    target: entity,
-                    offset: p,
-                }
-            });
+            spawn_anchored_outline(&mut commands, entity, &points, closed, transform);
             insert_shape(&mut commands, entity, points, closed, marker.tolerance);
             continue;
         };

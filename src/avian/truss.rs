@@ -15,7 +15,7 @@ use avian2d::prelude::Rotation;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::coupling::BodyAnchor;
+use super::anchor::BodyAnchor;
 use crate::colliders::ColliderOf;
 use crate::model::validate::rest_lengths_of;
 use crate::world::particle::{Particle, Position, Velocity};
