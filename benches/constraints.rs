@@ -145,14 +145,7 @@ fn constraint_stage(c: &mut Criterion) {
                     closed: false,
                 };
                 let bodies = Bodies::new(&pile.position, velocity, &pile.inverse_mass);
-                black_box(project_chain(
-                    chain,
-                    bodies,
-                    &[],
-                    dt,
-                    &settings,
-                    &mut scratch,
-                ));
+                black_box(project_chain(chain, bodies, dt, &settings, &mut scratch));
             }
         })
     });
@@ -255,14 +248,7 @@ fn structure_projection(c: &mut Criterion) {
                     }),
                 };
                 let bodies = Bodies::new(&structure.position, &mut velocity, &inverse_mass);
-                black_box(project_island(
-                    island,
-                    bodies,
-                    &[],
-                    dt,
-                    &settings,
-                    &mut scratch,
-                ))
+                black_box(project_island(island, bodies, dt, &settings, &mut scratch))
             })
         });
     }

@@ -1,27 +1,30 @@
 //! The contact loop: the only place where the constraint solve and collision processing
 //! meet.
 //!
-//! Collision impulses come after the constraint solve, so the edges next to contacts
-//! end a step stretched by them. After the first round of impulses, the islands that
-//! contacts touched are projected onto their constraints again with every contact as
-//! an inequality row (the pair may not approach beyond a cushion), and detection with
-//! impulses runs again on the result; this alternates until a round applies no impulse
-//! or [`ContactConfig::passes`] are done. Collisions always come last, so
-//! non-penetration is never traded for length: what the last round of impulses changes,
-//! edges keep (the report counts such steps as unsettled).
+//! Before any impulse, the contact solve (the Speculate sub-stage) turns every pair
+//! within reach into a contact row and projects the islands they touch jointly with
+//! them (`constraints::projection::project_jointly`): the rows keep pairs a cushion
+//! apart, with friction, and every edge stays exact. Continuous detection then
+//! verifies the step; what the rows' linearization missed gets collision impulses.
+//! After impulses, the islands they touched are projected again jointly, with every
+//! contact as a row that may not approach, and detection runs again; this alternates
+//! until a round applies no impulse or [`ContactConfig::passes`] are done. Collisions
+//! always come last, so non-penetration is never traded for length: what the last
+//! round of impulses left, the islands finish as exact rigid zones.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::collision::CollisionScratch;
-use crate::collision::impulses::Collider;
+use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
 use crate::constraints::Islands;
-use crate::constraints::projection::{Bodies, ContactRow, ProjectionSettings};
+use crate::constraints::projection::{Bodies, ContactRow, JointSettings, RowImpulse};
 use crate::metrics::StrandMetrics;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
 use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
+use crate::speculation::{SpeculationScratch, SpeculationSettings, speculative_rows};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
 use crate::world::state::ParticleState;
 use crate::world::topology::Topology;
@@ -44,34 +47,57 @@ impl Plugin for ContactLoopPlugin {
     }
 }
 
-/// The projection's settings with contact rows: the constraint settings, with the
-/// contact loop's correction guard and tolerance.
-fn contact_projection(
+/// The joint projection's settings: the constraint settings, with the contact loop's
+/// correction guard, tolerance and sweeps.
+fn joint_settings(
     contact: &ContactConfig,
     collisions: &CollisionConfig,
     constraints: &ConstraintConfig,
-) -> ProjectionSettings {
-    ProjectionSettings {
+    dt: f64,
+) -> JointSettings {
+    JointSettings {
+        projection: constraints.projection(),
+        sweeps: contact.sweeps,
+        contact_tolerance: contact.tolerance * collisions.thickness * dt,
         max_correction: contact.max_correction,
-        contact_tolerance: contact.tolerance * collisions.thickness,
-        ..constraints.projection()
     }
 }
 
-/// The contact rows of the latest re-projection, reused every step.
+/// The contact rows of the latest joint projection and the impulses they carried,
+/// reused every step.
 #[derive(Resource, Default, Debug)]
 pub struct ContactRows {
     /// The rows.
     pub rows: Vec<ContactRow>,
+    /// Each row's total impulse.
+    impulses: Vec<RowImpulse>,
+    /// Each speculative row's key (see [`speculative_rows`]).
+    keys: Vec<(u32, u32, u32)>,
+    speculation: SpeculationScratch,
     /// Each island projected, and whether it met its edges.
     outcomes: Vec<(u32, bool)>,
+    /// The last step's speculative impulses, by key, sorted: the warm start of the
+    /// same contacts' rows.
+    warm: Vec<(u32, u32, RowImpulse)>,
+    /// The topology version the warm starts belong to.
+    warm_version: u64,
 }
 
-/// The Speculate sub-stage: the points the projected motion would bring within `keep`
-/// of the thickness of an edge become rows, and their islands are projected again with
-/// them, before any impulse: against obstacles (walls, pinned edges) and between paths,
-/// which are projected together as one unit. An island whose projection with rows
-/// fails is projected alone again, so that the stage always leaves every edge met.
+impl ContactRows {
+    fn warm_start(&self, p: u32, key: u32) -> RowImpulse {
+        self.warm
+            .binary_search_by_key(&(p, key), |&(q, k, _)| (q, k))
+            .map_or(RowImpulse::default(), |i| self.warm[i].2)
+    }
+}
+
+/// The Speculate sub-stage: the contact solve. The pairs the broad phase finds for the
+/// projected motion become rows ([`speculative_rows`]: keep the cushion, no sliding
+/// beyond Coulomb's cone), and every island the rows touch is projected again jointly
+/// with them, both sides of each contact moving and every edge exact, warm-started
+/// from the previous step's impulses of the same contacts. An island whose joint
+/// projection fails is projected alone again, so that the stage always leaves every
+/// edge met.
 #[allow(clippy::too_many_arguments)]
 pub fn speculate(
     collisions: Res<CollisionConfig>,
@@ -85,13 +111,18 @@ pub fn speculate(
     mut buffers: ResMut<ContactRows>,
     mut metrics: ResMut<StrandMetrics>,
 ) {
-    if !(collisions.enabled && constraints.solver.projects_contacts() && contact.speculative) {
+    if !speculating(&collisions, &contact, &constraints) {
         return;
     }
-    let settings = contact_projection(&contact, &collisions, &constraints);
+    let settings = joint_settings(&contact, &collisions, &constraints, step.dt);
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
-    let keep = contact.keep * collisions.thickness;
+    let thickness = collisions.thickness;
+    let reach = contact.reach.max(1.0) * thickness;
     let buffers = &mut *buffers;
+    if buffers.warm_version != topology.version {
+        buffers.warm.clear();
+        buffers.warm_version = topology.version;
+    }
     let mut collider = collider(
         &mut state,
         &topology,
@@ -100,53 +131,66 @@ pub fn speculate(
         &mut scratch.impulses,
     );
     collider.find_pairs();
-    let (position, velocity, dt) = (collider.position, &*collider.velocity, collider.dt);
-    buffers.rows.clear();
-    let groups = collider.groups;
-    for &(p, k) in &collider.scratch.pairs {
-        let e = &collider.edges[k as usize];
-        // A row between two free islands is met by both at once only when both are
-        // paths (one unit); with a loop, tree or graph the island sweep would push the
-        // first one solved, so those pairs stay with the momentum-conserving impulses.
-        if !islands.one_unit([p, e.a, e.b].map(|i| groups[i as usize])) {
-            continue;
-        }
-        let (q, r) = (position[e.a as usize], position[e.b as usize]);
-        let x = position[p as usize];
-        let (alpha, gap) = closest_on_segment(x, q, r);
-        if gap <= 0.0 {
-            continue; // on the edge: the collision stage decides its side
-        }
-        let normal = (x - q.lerp(r, alpha)) / gap;
-        let pair = PointEdgePair {
-            p: p as usize,
-            q: e.a as usize,
-            r: e.b as usize,
-            alpha,
-        };
-        let mut row = ContactRow::point_edge(pair, normal, velocity);
-        if gap + dt * row.target >= keep {
-            continue; // ends the step farther than `keep` along the normal
-        }
-        // Approach allowed down to `keep`; from closer, no further.
-        row.target = if gap >= keep { (keep - gap) / dt } else { 0.0 };
-        buffers.rows.push(row);
+    collider.scratch.speculated.clear();
+    collider.scratch.speculated_step = true;
+    let dt = collider.dt;
+    speculative_rows(
+        &collider.scratch.pairs,
+        collider.edges,
+        collider.position,
+        collider.velocity,
+        dt,
+        &SpeculationSettings {
+            thickness,
+            keep: contact.keep * thickness,
+            reach,
+            friction: collisions.friction,
+            down: step.gravity.normalize_or_zero(),
+        },
+        &mut buffers.speculation,
+        &mut buffers.rows,
+        &mut buffers.keys,
+    );
+    buffers.impulses.clear();
+    for &(p, key, _) in &buffers.keys {
+        let warm = buffers.warm_start(p, key);
+        buffers.impulses.push(warm);
     }
     if buffers.rows.is_empty() {
+        buffers.warm.clear();
         return;
     }
     let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
-    islands.project_with_contacts(
+    islands.project_jointly(
         collider.groups,
         &mut bodies,
         &buffers.rows,
+        &mut buffers.impulses,
         dt,
         &settings,
-        contact.sweeps,
-        false,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
     );
+    // Remember the impulses for the next step's rows of the same pairs, and the
+    // contacts that took one.
+    buffers.warm.clear();
+    let rows = buffers
+        .keys
+        .iter()
+        .zip(&buffers.impulses)
+        .zip(&buffers.rows);
+    for ((&(p, key, edge), impulse), row) in rows {
+        if impulse.normal > 0.0 {
+            buffers.warm.push((p, key, *impulse));
+            collider.scratch.speculated.push(Contact {
+                p,
+                edge,
+                alpha: -row.coefficients[2],
+                normal: row.normal,
+            });
+        }
+    }
+    buffers.warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
     for &(island, met) in &buffers.outcomes {
         if !met {
             islands.project_alone(
@@ -158,6 +202,16 @@ pub fn speculate(
             );
         }
     }
+}
+
+/// Whether the Speculate sub-stage runs its contact solve (and so takes the place of
+/// the proximity impulses).
+fn speculating(
+    collisions: &CollisionConfig,
+    contact: &ContactConfig,
+    constraints: &ConstraintConfig,
+) -> bool {
+    collisions.enabled && constraints.solver.projects_contacts() && contact.speculative
 }
 
 /// The ContactLoop sub-stage: alternate re-projection with contact rows and collision
@@ -178,7 +232,7 @@ pub fn contact_loop(
     if !(collisions.enabled && constraints.solver.projects_contacts() && contact.passes > 0) {
         return;
     }
-    let settings = contact_projection(&contact, &collisions, &constraints);
+    let settings = joint_settings(&contact, &collisions, &constraints, step.dt);
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let scratch = &mut *scratch;
     let mut changed = scratch.outcome.impulses > 0;
@@ -221,11 +275,11 @@ fn reproject(
     collider: &mut Collider,
     contact: &ContactConfig,
     islands: &mut Islands,
-    settings: &ProjectionSettings,
+    settings: &JointSettings,
     buffers: &mut ContactRows,
     metrics: &mut StrandMetrics,
 ) {
-    let rows = &mut buffers.rows;
+    let (rows, impulses) = (&mut buffers.rows, &mut buffers.impulses);
     // Rows: every contact met this step, and every pair already closer than `reach`
     // thicknesses. Each may approach while it ends the step at least `keep` of the
     // thickness apart.
@@ -264,15 +318,16 @@ fn reproject(
             rows.push(row(p, e, alpha, (x - contact_point) / distance));
         }
     }
+    impulses.clear();
+    impulses.resize(rows.len(), RowImpulse::default());
     let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
-    islands.project_with_contacts(
+    islands.project_jointly(
         collider.groups,
         &mut bodies,
         rows,
+        impulses,
         dt,
         settings,
-        contact.sweeps,
-        true,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
     );

@@ -52,6 +52,7 @@ pub mod render;
 pub mod ribbon;
 pub mod schedule;
 pub mod snapshot;
+pub mod speculation;
 pub mod tearing;
 pub mod transforms;
 pub mod winch;

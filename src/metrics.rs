@@ -116,7 +116,12 @@ pub struct StrandMetrics {
     pub projection: IterationStats,
     /// Re-projections of islands in contact (the contact loop).
     pub contact_projection: IterationStats,
-    /// Collision impulses applied.
+    /// Point–edge contacts met, summed over steps: each step, every pair that the
+    /// contact solve held apart with an impulse or that a collision impulse pushed
+    /// apart, once.
+    pub contacts: u64,
+    /// Collision impulses applied (after the contact solve: what it left to the
+    /// continuous detection).
     pub collisions: u64,
     /// Collision impulses applied in the latest step.
     pub collisions_last_step: u64,

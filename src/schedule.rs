@@ -10,13 +10,14 @@
 //! 3. **Constrain** — the sub-stages of [`ConstrainSet`], in order:
 //!    1. **Project** — every island's velocities projected so that each constrained
 //!       edge ends the step at its rest length.
-//!    2. **Speculate** — the points that motion would bring within half the cushion
-//!       of a wall or another edge that cannot move become contact rows, and their
-//!       islands are projected again with them: the projection sees those contacts
-//!       before any impulse.
+//!    2. **Speculate** — the contact solve: every point that motion would bring
+//!       within reach of an edge becomes a contact row (keep a thickness apart, with
+//!       friction), and every island the rows touch is projected again jointly with
+//!       them, both sides of each contact moving, every edge exact.
 //! 4. **Collide** — the sub-stages of [`CollideSet`], in order:
-//!    1. **Proximity** — candidate pairs for the step's motion; pairs that would end
-//!       the step closer than the thickness are pushed apart.
+//!    1. **Proximity** — the contact solve's contacts become the step's; without a
+//!       contact solve (the relaxation baselines, or speculation off), pairs that
+//!       would end the step closer than the thickness are pushed apart by impulses.
 //!    2. **Impulses** — continuous point–edge detection, an impulse per collision,
 //!       repeated until a pass finds none; the rigid-impact-zone fail-safe if the cap
 //!       is reached.
@@ -91,8 +92,9 @@ pub enum StepSet {
 pub enum ConstrainSet {
     /// Every island projected onto its edge constraints.
     Project,
-    /// Speculative contact rows for the points the projected motion brings close to an
-    /// edge that cannot move, and the islands they touch projected again with them.
+    /// The contact solve: speculative contact rows for the points the projected
+    /// motion brings close to an edge, and the islands they touch projected again
+    /// jointly with them.
     Speculate,
 }
 

@@ -69,7 +69,7 @@ fn strands_thrown_at_each_other_never_cross() {
     ticks(&mut app, 10);
     assert_eq!(crossings(&app), 0);
     let metrics = app.world().resource::<StrandMetrics>();
-    assert!(metrics.collisions > 0, "they never met");
+    assert!(metrics.contacts > 0, "they never met");
     assert!(
         metrics.max_rel_length_error < 1e-12,
         "{:e}",
@@ -129,7 +129,7 @@ fn a_pile_of_fifty_strands_never_crosses_and_keeps_its_lengths() {
     assert_eq!(crossings(&app), 0);
     let metrics = app.world().resource::<StrandMetrics>();
     assert_eq!(metrics.strands, 51);
-    assert!(metrics.collisions > 10_000, "no pile formed");
+    assert!(metrics.contacts > 10_000, "no pile formed");
     // Lengths hold through contact, not just away from it.
     assert!(
         metrics.max_rel_length_error < 1e-9,

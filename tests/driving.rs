@@ -219,7 +219,7 @@ fn a_pixel_world_with_its_length_unit_moves_as_the_metre_world_scaled() {
         {
             assert!(m.distance(px / unit) < 1e-9, "{m} against {}", px / unit);
         }
-        landed |= metres.world().resource::<StrandMetrics>().collisions > 0;
+        landed |= metres.world().resource::<StrandMetrics>().contacts > 0;
     }
     assert!(landed, "the rope reached the floor");
     let error = |app: &App| app.world().resource::<StrandMetrics>().max_rel_length_error;

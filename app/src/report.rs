@@ -96,7 +96,10 @@ pub struct Report {
     pub edge_crossings: Option<u64>,
     /// The first of those, with its edges; null if none (or unchecked).
     pub first_crossing: Option<CrossingReport>,
-    /// Collision impulses applied.
+    /// Point–edge contacts met, summed over steps (held by the contact solve or pushed
+    /// apart by a collision impulse).
+    pub contacts: u64,
+    /// Collision impulses applied (what the contact solve left to continuous detection).
     pub collisions: u64,
     /// Steps that needed the collision fail-safe.
     pub failsafe_steps: u64,
@@ -183,6 +186,7 @@ impl Report {
                 format!("{:.3e}", self.max_rel_length_error_free),
             ),
             ("edge_crossings", crossings),
+            ("contacts", self.contacts.to_string()),
             ("collisions", self.collisions.to_string()),
             ("failsafe_steps", self.failsafe_steps.to_string()),
             (

@@ -477,6 +477,7 @@ fn report(
         max_rel_length_error_free: metrics.max_rel_length_error_free,
         edge_crossings: metrics.edge_crossings,
         first_crossing,
+        contacts: metrics.contacts,
         collisions: metrics.collisions,
         failsafe_steps: metrics.failsafe_steps,
         projection_iterations_mean: metrics.projection.mean(),

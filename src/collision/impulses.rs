@@ -60,6 +60,12 @@ pub struct ImpulseScratch {
     displacement: Vec<DVec2>,
     /// Every contact met this step, one per point and edge.
     pub contacts: Vec<Contact>,
+    /// The contacts the contact solve (before any impulse) met this step with an
+    /// impulse; they stand for the proximity pass's when `speculated_step` is set.
+    pub speculated: Vec<Contact>,
+    /// Whether the contact solve ran this step (set by it, taken by the proximity
+    /// stage).
+    pub speculated_step: bool,
     contact_index: HashMap<(u32, u32), u32>,
     /// The fail-safe's rigid impact zones of this step.
     pub zones: ImpactZones,
@@ -90,6 +96,21 @@ impl ImpulseScratch {
     /// Whether some group's edges may be stretched by impulses.
     pub fn any_dirty(&self) -> bool {
         self.dirty.iter().any(|&d| d)
+    }
+
+    /// Record a contact that changed no velocity outside a projection (one the contact
+    /// solve met): it is in the step's contacts, and its groups stay clean.
+    pub fn record(&mut self, contact: Contact) {
+        let next = self.contacts.len() as u32;
+        let slot = *self
+            .contact_index
+            .entry((contact.p, contact.edge))
+            .or_insert(next);
+        if slot == next {
+            self.contacts.push(contact);
+        } else {
+            self.contacts[slot as usize] = contact;
+        }
     }
 
     /// Whether point `p` met edge `edge` this step.
@@ -227,17 +248,23 @@ impl Collider<'_> {
                 scratch.dirty[g as usize] = true;
             }
         }
-        let next = scratch.contacts.len() as u32;
-        let slot = *scratch
-            .contact_index
-            .entry((contact.p, edge))
-            .or_insert(next);
-        if slot == next {
-            scratch.contacts.push(contact);
-        } else {
-            scratch.contacts[slot as usize] = contact;
-        }
+        scratch.record(contact);
         true
+    }
+
+    /// Take the contact solve's contacts as this step's: recorded, their free
+    /// particles marked in contact.
+    pub fn adopt_speculated(&mut self) {
+        let scratch = &mut *self.scratch;
+        for slot in 0..scratch.speculated.len() {
+            let contact = scratch.speculated[slot];
+            scratch.record(contact);
+            let e = &self.edges[contact.edge as usize];
+            for i in [contact.p, e.a, e.b] {
+                let i = i as usize;
+                self.in_contact[i] |= self.inverse_mass[i] > 0.0;
+            }
+        }
     }
 
     /// Repulsion for pairs that would end the step closer than the thickness.

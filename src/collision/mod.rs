@@ -2,8 +2,10 @@
 //!
 //! On the velocities the constraint solve left, each step:
 //!
-//! 1. **Proximity** — pairs that would end the step closer than the thickness `h` get
-//!    a repulsion impulse, with Coulomb friction.
+//! 1. **Proximity** — when the contact solve ran (the crate's `contact_loop`), its
+//!    contacts are the step's and no impulse is needed; otherwise pairs that would end
+//!    the step closer than the thickness `h` get a repulsion impulse, with Coulomb
+//!    friction.
 //! 2. **Continuous detection** — every point against every edge it is not part of,
 //!    over the step's linear motion ([`ccd`]); each contact gets an inelastic impulse
 //!    with friction ([`response`]); detection repeats with the new velocities until a

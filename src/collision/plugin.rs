@@ -114,6 +114,14 @@ pub fn proximity(
         step.dt,
         &mut scratch.impulses,
     );
+    if std::mem::take(&mut collider.scratch.speculated_step) {
+        // The contact solve kept the cushion, inside the exact projection: its
+        // contacts are the step's, and no impulse is needed.
+        collider.adopt_speculated();
+        scratch.outcome = CollisionOutcome::default();
+        scratch.stale = true;
+        return;
+    }
     collider.find_pairs();
     let impulses = collider.proximity_pass();
     scratch.outcome = CollisionOutcome {
@@ -163,6 +171,7 @@ pub fn account_collisions(
         return;
     }
     let total = scratch.outcome;
+    metrics.contacts += scratch.impulses.contacts.len() as u64;
     metrics.collisions += total.impulses;
     metrics.collisions_last_step = total.impulses;
     metrics.failsafe_steps += u64::from(total.failsafe);

@@ -16,21 +16,6 @@ pub struct IslandEdge {
 }
 
 impl IslandEdge {
-    /// The `edge` of a [`gap`](Self::gap).
-    pub const GAP: u32 = u32::MAX;
-
-    /// Not an edge: joins the end of one path to the start of the next where several
-    /// are projected as one chain. It is locked (no multiplier, no coupling), and its
-    /// infinite rest length keeps it out of every "shortest edge".
-    pub fn gap(a: u32, b: u32) -> IslandEdge {
-        IslandEdge {
-            a,
-            b,
-            rest_length: f64::INFINITY,
-            edge: Self::GAP,
-        }
-    }
-
     /// Edges joining `pairs` of `points`, each at its current length, numbered in order
     /// (for kernels used without a topology: tests, benchmarks, tools).
     pub fn between(points: &[DVec2], pairs: &[(u32, u32)]) -> Vec<IslandEdge> {

@@ -5,10 +5,9 @@
 //! are found once per topology change ([`islands`]); the kind of an island picks its
 //! solver ([`solver`]). The kernels are pure functions on slices: the linear solves
 //! ([`tridiagonal`], [`cyclic`], [`sparse`] on a [`graph`] layout), the projection with
-//! its contact rows ([`projection`], [`complementarity`]) and the relaxation baselines
+//! the joint projection of islands in contact ([`projection`]) and the relaxation baselines
 //! ([`relaxation`]); [`plugin`] holds the thin systems.
 
-pub mod complementarity;
 pub mod cyclic;
 pub mod graph;
 pub mod island_edge;

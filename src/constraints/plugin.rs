@@ -4,16 +4,16 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use super::island_edge::IslandEdge;
 use super::islands::{IslandKind, IslandSet, find_islands};
 use super::projection::{
-    Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, ProjectionSettings, project_island,
+    Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, JointOutcome, JointScratch,
+    JointSettings, ProjectionOutcome, ProjectionSettings, RowImpulse, project_island,
+    project_jointly,
 };
 use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
 use crate::metrics::{IterationStats, StrandMetrics, count_elements};
 use crate::model::NO_ISLAND;
-use crate::model::union_find::UnionFind;
 use crate::schedule::{ConstrainSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
@@ -32,16 +32,11 @@ pub struct Islands {
     /// Islands of a kind the configured solver cannot solve (their edges keep stretch
     /// springs).
     pub unsolved: Vec<usize>,
-    touched: Vec<(u32, u32)>,
-    units: UnionFind,
-    /// (unit, island) of every island a contact touches, by unit.
-    members: Vec<(u32, u32)>,
-    row_ids: Vec<u32>,
-    unit_rows: Vec<u32>,
-    group_edges: Vec<IslandEdge>,
-    rows: Vec<ContactRow>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
+    joint: JointScratch,
+    joint_islands: Vec<u32>,
+    joint_loose: Vec<u32>,
     lanes: Vec<Lane>,
     /// Each topology edge's impulse this step, summed over every projection of the
     /// step (mass × length, tension positive): see [`Islands::edge_tension`].
@@ -70,19 +65,6 @@ impl Islands {
         self.set.islands.iter().filter(|i| i.kind == kind).count()
     }
 
-    /// Whether contact rows among particles of `islands` (each particle's island, or
-    /// `NO_ISLAND` for a pinned one) can be projected as one unit: they touch at most
-    /// one free island, or only paths.
-    pub fn one_unit(&self, islands: [u32; 3]) -> bool {
-        let mut free = islands.into_iter().filter(|&i| i != NO_ISLAND);
-        let Some(first) = free.next() else {
-            return true;
-        };
-        let is_path = |i: u32| self.set.islands[i as usize].kind == IslandKind::Path;
-        let mut rest = free.filter(|&i| i != first).peekable();
-        rest.peek().is_none() || (is_path(first) && rest.all(is_path))
-    }
-
     /// Project every solved island (the Constrain stage), recording each solve.
     ///
     /// With `threads` above one and enough edges, contiguous shares of the islands
@@ -104,7 +86,7 @@ impl Islands {
         if threads <= 1 || edges < PARALLEL_EDGES {
             for slot in 0..self.solved.len() {
                 let i = self.solved[slot];
-                self.project_island(i, bodies, &[], dt, settings, stats);
+                self.project_island(i, bodies, dt, settings, stats);
             }
             return;
         }
@@ -146,11 +128,10 @@ impl Islands {
                 scope.spawn(move || {
                     let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass);
                     for slot in lane.slots.clone() {
-                        let view = island_view(set, solved[slot]);
+                        let view = IslandView::of(set, solved[slot]);
                         project_met(
                             view,
                             &mut own,
-                            &[],
                             dt,
                             settings,
                             &mut lane.scratch,
@@ -161,8 +142,8 @@ impl Islands {
                 });
             }
             for slot in first {
-                let view = island_view(set, solved[slot]);
-                project_met(view, bodies, &[], dt, settings, scratch, stats, impulse);
+                let view = IslandView::of(set, solved[slot]);
+                project_met(view, bodies, dt, settings, scratch, stats, impulse);
             }
         });
         // Each lane's islands' velocities back; a pinned particle two islands share is
@@ -173,9 +154,7 @@ impl Islands {
                     for j in [e.a as usize, e.b as usize] {
                         bodies.velocity[j] = lane.velocity[j];
                     }
-                    if e.edge != IslandEdge::GAP {
-                        impulse[e.edge as usize] += lane.impulse[e.edge as usize];
-                    }
+                    impulse[e.edge as usize] += lane.impulse[e.edge as usize];
                 }
             }
             stats.merge(&lane.stats);
@@ -191,7 +170,7 @@ impl Islands {
         settings: &ProjectionSettings,
         stats: &mut IterationStats,
     ) -> bool {
-        self.project_island(island, bodies, &[], dt, settings, stats)
+        self.project_island(island, bodies, dt, settings, stats)
     }
 
     /// Relax every solved island (the Constrain stage of the baseline solvers),
@@ -218,217 +197,10 @@ impl Islands {
         }
     }
 
-    /// Project again the islands that `contacts` touch (`island` gives each particle's,
-    /// as [`Topology::island`] does), each with its contact rows:
-    /// Gauss–Seidel sweeps over those islands, each solved exactly with the other sides
-    /// of its contacts frozen, until no contact falls short by more than the settings'
-    /// contact tolerance or `sweeps` are done. Each island's last projection is told in
-    /// `outcomes` (island, whether it met its edges). Returns the largest shortfall
-    /// left, as a speed.
-    ///
-    /// A row between two units pushes the unit being solved alone, so it changes the
-    /// momentum by its impulse; with `across_units` false such rows are left out (to
-    /// the collision impulses, which push both sides). Speculative rows must be: they
-    /// stop whole approaches, and at 1/600 two strands thrown at each other lost a
-    /// third of their momentum to them. The contact loop's rows, after the impulses,
-    /// only keep the edge projection from approaching again; their impulses are
-    /// small, and without them the factories at 1/300 fell to the fail-safe at most
-    /// steps.
-    #[allow(clippy::too_many_arguments)]
-    pub fn project_with_contacts(
-        &mut self,
-        island: &[u32],
-        bodies: &mut Bodies,
-        contacts: &[ContactRow],
-        dt: f64,
-        settings: &ProjectionSettings,
-        sweeps: u32,
-        across_units: bool,
-        stats: &mut IterationStats,
-        outcomes: &mut Vec<(u32, bool)>,
-    ) -> f64 {
-        outcomes.clear();
-        let tolerance = settings.contact_tolerance / dt;
-        self.form_units(island, contacts);
-        let crosses_units = contacts.iter().any(|row| {
-            let mut units = row
-                .particles
-                .iter()
-                .filter_map(|&p| island_of(island, p as usize))
-                .map(|i| self.units.find(i));
-            units.next().is_some_and(|first| units.any(|u| u != first))
-        });
-        let mut shortfall = contacts
-            .iter()
-            .map(|row| row.target - row.normal_velocity(bodies.velocity))
-            .fold(0.0, f64::max);
-        for _ in 0..sweeps {
-            let mut all_met = true;
-            let mut start = 0;
-            while start < self.members.len() {
-                let unit = self.members[start].0;
-                let end = start
-                    + self.members[start..]
-                        .iter()
-                        .take_while(|t| t.0 == unit)
-                        .count();
-                // The unit's rows: every contact touching one of its islands, once.
-                self.rows.clear();
-                self.row_ids.clear();
-                for &(_, member) in &self.members[start..end] {
-                    let from = self.touched.partition_point(|t| t.0 < member);
-                    for &(i, c) in &self.touched[from..] {
-                        if i != member {
-                            break;
-                        }
-                        self.row_ids.push(c);
-                    }
-                }
-                self.row_ids.sort_unstable();
-                self.row_ids.dedup();
-                for &c in &self.row_ids {
-                    let row = &contacts[c as usize];
-                    let mut inside = || {
-                        row.particles.iter().all(|&p| {
-                            island_of(island, p as usize)
-                                .is_none_or(|i| self.units.find(i) as u32 == unit)
-                        })
-                    };
-                    if across_units || inside() {
-                        self.rows.push(*row);
-                    }
-                }
-                let rows = std::mem::take(&mut self.rows);
-                let met = if end - start == 1 {
-                    self.project_island(unit as usize, bodies, &rows, dt, settings, stats)
-                } else {
-                    self.project_group(start..end, bodies, &rows, dt, settings, stats)
-                };
-                all_met &= met;
-                for &(_, member) in &self.members[start..end] {
-                    match outcomes.iter_mut().find(|(i, _)| *i == member) {
-                        Some(outcome) => outcome.1 = met,
-                        None => outcomes.push((member, met)),
-                    }
-                }
-                self.rows = rows;
-                start = end;
-            }
-            shortfall = contacts
-                .iter()
-                .map(|row| row.target - row.normal_velocity(bodies.velocity))
-                .fold(0.0, f64::max);
-            // Each unit met its own contacts exactly; only contacts between units can
-            // have been disturbed since. A unit that could not meet its rows against
-            // the others' motion may meet them once the others have moved (a heavy
-            // body stopped on a taut rope): it is tried again.
-            if all_met && (!crosses_units || shortfall <= tolerance) {
-                break;
-            }
-        }
-        shortfall
-    }
-
-    /// Which islands `contacts` touch, and the units they are projected in: paths that
-    /// touch each other are one unit, solved as one problem (their systems side by
-    /// side, the contact rows between them eliminated together), as long as the unit's
-    /// rows stay within [`UNIT_ROWS`]; a loop, tree or graph is a unit of its own. Units meet
-    /// each other's contacts by the sweeps of block Gauss–Seidel.
-    fn form_units(&mut self, island: &[u32], contacts: &[ContactRow]) {
-        self.touched.clear();
-        for (c, row) in contacts.iter().enumerate() {
-            for &p in &row.particles {
-                if let Some(i) = island_of(island, p as usize) {
-                    self.touched.push((i as u32, c as u32));
-                }
-            }
-        }
-        self.touched.sort_unstable();
-        self.touched.dedup();
-        self.units.reset(self.set.islands.len());
-        // Rows touching each unit (an upper bound: a row between two counts twice). The
-        // unit's dense contact problem costs about the cube of its rows. Rows between
-        // units are one-sided (see `project_with_contacts`): with all of them left out,
-        // the factories at 1/600 took 263 and 2,377 fail-safe steps in 10 s with units
-        // of 64 rows, 5 and 23 with 128.
-        self.unit_rows.clear();
-        self.unit_rows.resize(self.set.islands.len(), 0);
-        for &(i, _) in &self.touched {
-            self.unit_rows[i as usize] += 1;
-        }
-        let is_path = |i: usize| self.set.islands[i].kind == IslandKind::Path;
-        for row in contacts {
-            let mut paths = row
-                .particles
-                .iter()
-                .filter_map(|&p| island_of(island, p as usize))
-                .filter(|&i| is_path(i));
-            if let Some(first) = paths.next() {
-                for other in paths {
-                    let (a, b) = (self.units.find(first), self.units.find(other));
-                    let joined = self.unit_rows[a] + self.unit_rows[b];
-                    if a != b && joined as usize <= UNIT_ROWS {
-                        self.units.union(a, b);
-                        self.unit_rows[a.min(b)] = joined;
-                    }
-                }
-            }
-        }
-        self.members.clear();
-        let mut previous = u32::MAX;
-        for t in 0..self.touched.len() {
-            let i = self.touched[t].0;
-            if i != previous {
-                let unit = self.units.find(i as usize) as u32;
-                self.members.push((unit, i));
-                previous = i;
-            }
-        }
-        // A unit's islands in order, the unit named by its smallest island.
-        self.members.sort_unstable();
-    }
-
-    /// Project the paths `self.members[members]` together with `contacts`: one open
-    /// chain through all of them, consecutive paths joined by a locked gap edge that
-    /// couples nothing; whether every path met its edges.
-    fn project_group(
-        &mut self,
-        members: std::ops::Range<usize>,
-        bodies: &mut Bodies,
-        contacts: &[ContactRow],
-        dt: f64,
-        settings: &ProjectionSettings,
-        stats: &mut IterationStats,
-    ) -> bool {
-        self.group_edges.clear();
-        for &(_, member) in &self.members[members] {
-            let edges = &self.set.edges[self.set.islands[member as usize].edges.clone()];
-            if let (Some(last), Some(first)) = (self.group_edges.last(), edges.first()) {
-                self.group_edges.push(IslandEdge::gap(last.b, first.a));
-            }
-            self.group_edges.extend_from_slice(edges);
-        }
-        let unit = IslandView::Chain(Chain {
-            edges: &self.group_edges,
-            closed: false,
-        });
-        project_met(
-            unit,
-            bodies,
-            contacts,
-            dt,
-            settings,
-            &mut self.scratch,
-            stats,
-            &mut self.impulse,
-        )
-    }
-
     fn project_island(
         &mut self,
         island: usize,
         bodies: &mut Bodies,
-        contacts: &[ContactRow],
         dt: f64,
         settings: &ProjectionSettings,
         stats: &mut IterationStats,
@@ -439,10 +211,77 @@ impl Islands {
             impulse,
             ..
         } = self;
-        let view = island_view(set, island);
-        project_met(
-            view, bodies, contacts, dt, settings, scratch, stats, impulse,
-        )
+        let view = IslandView::of(set, island);
+        project_met(view, bodies, dt, settings, scratch, stats, impulse)
+    }
+
+    /// Project jointly every island that `rows` touch, and the loose free particles
+    /// they touch, with the rows: both sides of every contact move, each island as a
+    /// whole (see [`project_jointly`]). `island` gives each particle's island, as
+    /// [`Topology::island`] does; `impulses[c]` is row c's warm start on entry and its
+    /// total impulse on return. `outcomes` tells, for each island projected, whether
+    /// it met its edges.
+    #[allow(clippy::too_many_arguments)]
+    pub fn project_jointly(
+        &mut self,
+        island: &[u32],
+        bodies: &mut Bodies,
+        rows: &[ContactRow],
+        impulses: &mut [RowImpulse],
+        dt: f64,
+        settings: &JointSettings,
+        stats: &mut IterationStats,
+        outcomes: &mut Vec<(u32, bool)>,
+    ) -> JointOutcome {
+        outcomes.clear();
+        self.joint_islands.clear();
+        self.joint_loose.clear();
+        for row in rows {
+            for &p in &row.particles {
+                match island_of(island, p as usize) {
+                    Some(i) => self.joint_islands.push(i as u32),
+                    None if bodies.inverse_mass[p as usize] > 0.0 => self.joint_loose.push(p),
+                    None => {}
+                }
+            }
+        }
+        for list in [&mut self.joint_islands, &mut self.joint_loose] {
+            list.sort_unstable();
+            list.dedup();
+        }
+        if self.joint_islands.is_empty() && self.joint_loose.is_empty() {
+            return JointOutcome {
+                converged: true,
+                ..Default::default()
+            };
+        }
+        let outcome = project_jointly(
+            &self.set,
+            &self.joint_islands,
+            &self.joint_loose,
+            bodies.reborrow(),
+            rows,
+            impulses,
+            dt,
+            settings,
+            &mut self.joint,
+        );
+        for (i, &member) in self.joint_islands.iter().enumerate() {
+            outcomes.push((member, self.joint.island_met(i)));
+            let edges = &self.set.edges[self.set.islands[member as usize].edges.clone()];
+            for (e, j) in edges.iter().zip(self.joint.edge_impulses(i)) {
+                if let Some(slot) = self.impulse.get_mut(e.edge as usize) {
+                    *slot += j;
+                }
+            }
+        }
+        stats.record(&ProjectionOutcome {
+            iterations: outcome.iterations,
+            converged: outcome.converged,
+            residual: outcome.residual,
+            ..Default::default()
+        });
+        outcome
     }
 
     /// Forget the last step's impulses (sized to the topology at its rebuild).
@@ -459,29 +298,12 @@ impl Islands {
     }
 }
 
-/// The view of island `island` of `set`.
-fn island_view(set: &IslandSet, island: usize) -> IslandView<'_> {
-    let island = &set.islands[island];
-    let edges = &set.edges[island.edges.clone()];
-    match island.graph {
-        Some(g) => IslandView::Graph(Graph {
-            edges,
-            layout: &set.graphs[g],
-        }),
-        None => IslandView::Chain(Chain {
-            edges,
-            closed: island.kind == IslandKind::Cycle,
-        }),
-    }
-}
-
 /// Project `view`, record the solve and its edges' impulses (into `impulse`, by
 /// topology edge), and tell whether it met its edges.
 #[allow(clippy::too_many_arguments)]
 fn project_met(
     view: IslandView,
     bodies: &mut Bodies,
-    contacts: &[ContactRow],
     dt: f64,
     settings: &ProjectionSettings,
     scratch: &mut IslandScratch,
@@ -491,7 +313,7 @@ fn project_met(
     let edges = match view {
         IslandView::Chain(Chain { edges, .. }) | IslandView::Graph(Graph { edges, .. }) => edges,
     };
-    let outcome = project_island(view, bodies.reborrow(), contacts, dt, settings, scratch);
+    let outcome = project_island(view, bodies.reborrow(), dt, settings, scratch);
     for (e, j) in edges.iter().zip(scratch.edge_impulses(edges.len())) {
         if let Some(slot) = impulse.get_mut(e.edge as usize) {
             *slot += j;
@@ -500,10 +322,6 @@ fn project_met(
     stats.record(&outcome);
     outcome.converged && !outcome.rejected && !outcome.singular
 }
-
-/// The most contact rows paths are joined into one unit for (an island alone may take
-/// up to [`MAX_CONTACT_ROWS`](super::projection::MAX_CONTACT_ROWS)).
-const UNIT_ROWS: usize = 128;
 
 /// The island of `particle`, if it is in one.
 fn island_of(island: &[u32], particle: usize) -> Option<usize> {

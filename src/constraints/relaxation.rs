@@ -159,8 +159,6 @@ mod tests {
             tolerance: 1e-12,
             max_iterations: iterations,
             direction: ConstraintDirection::EndOfStep,
-            contact_tolerance: 0.0,
-            max_correction: f64::INFINITY,
         }
     }
 

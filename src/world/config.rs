@@ -194,8 +194,6 @@ impl ConstraintConfig {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             direction: self.direction,
-            contact_tolerance: 0.0,
-            max_correction: f64::INFINITY,
         }
     }
 
@@ -304,30 +302,33 @@ pub struct ContactConfig {
     /// pass finds no new collision, so at small steps one or two run whatever the cap.
     /// 0 leaves edges next to contacts as the impulses leave them.
     pub passes: u32,
-    /// Gauss–Seidel sweeps over the contact units per re-projection, at most. Paths in
-    /// contact are one unit already, and the contact loop's passes sweep again with
-    /// the impulses in between: at dt = 1/600 two sweeps made a dense pile 2.5 times
-    /// faster than eight (and the factories 1.1 to 1.5 times), leaving a few more
-    /// steps to the exact fail-safe; at 1/3000 the cap is never reached.
+    /// Gauss–Seidel sweeps over the contact rows per Newton step of a joint
+    /// projection, at most. The impulses are warm-started from the previous step, so
+    /// a resting pile needs few; the cap bounds a step's cost when many contacts
+    /// change at once.
     pub sweeps: u32,
-    /// A re-projection that would move any particle by more than this many of its
-    /// island's shortest rest lengths in one step is refused: room for a strand that
-    /// lands moving a good part of an edge per step, while a nearly dependent set of
-    /// rows asking for absurd corrections is still refused.
+    /// A joint projection that would move any particle by more than this many of its
+    /// island's shortest rest lengths in one step is refused for that island: room for
+    /// a strand that lands moving a good part of an edge per step, while a nearly
+    /// dependent set of rows asking for absurd corrections is still refused.
     pub max_correction: f64,
-    /// Contact rows are met to this fraction of the thickness per step (the edges are
-    /// met exactly whatever the contacts do).
+    /// Contact rows are met to this many thicknesses per second (a row may end the
+    /// step short of its target by `tolerance × thickness × dt`); the edges are met
+    /// exactly whatever the contacts do. It is the speed at which a resting pile may
+    /// creep into its cushion between steps.
     pub tolerance: f64,
-    /// A row may approach while the pair ends the step at least this fraction of the
-    /// thickness apart (the next proximity pass restores the rest); asking for no
-    /// approach at all over-constrains a jammed pile.
+    /// A pair inside the cushion may stay where it is while it is at least this
+    /// fraction of the thickness apart; closer, its row pushes it out to it. Asking
+    /// every resting pair back to the full thickness makes a pile breathe.
     pub keep: f64,
-    /// Pairs closer than this many thicknesses get a row even without a contact.
+    /// Pairs that start or would end the step within this many thicknesses get a
+    /// row.
     pub reach: f64,
-    /// Before any impulse, points the projected motion would bring within `keep` of the
-    /// thickness of an edge that cannot move (a wall, a pinned edge) become rows of a
-    /// second projection (speculative contacts): at large steps most landings are then
-    /// met by the projection, which keeps the edges exact, rather than by impulses.
+    /// Run the contact solve before any impulse (speculative contacts): every pair
+    /// within reach becomes a row of a joint projection, so landings, resting contact
+    /// and strands lying on strands are met inside the exact projection, both sides
+    /// moving, rather than by impulses. Off, proximity and collision impulses do the
+    /// work and the contact loop re-projects what they stretched.
     pub speculative: bool,
 }
 
@@ -335,9 +336,9 @@ impl Default for ContactConfig {
     fn default() -> Self {
         Self {
             passes: 16,
-            sweeps: 2,
+            sweeps: 16,
             max_correction: 2.0,
-            tolerance: 1e-3,
+            tolerance: 1.0,
             keep: 0.5,
             reach: 2.0,
             speculative: true,

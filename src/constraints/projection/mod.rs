@@ -1,5 +1,5 @@
-//! Fast projection of an island onto its length constraints, optionally subject to
-//! contacts that must not approach. A path or a loop has a tridiagonal
+//! Fast projection of an island onto its length constraints. A path or a loop has a
+//! tridiagonal
 //! system (Thomas; Sherman–Morrison for the loop's corners); a tree or a general graph
 //! a sparse one, factored by [`super::sparse`] in the order its layout planned.
 //!
@@ -23,25 +23,17 @@
 //! restore the length, and the iteration stalls (SHAKE's known failure); the
 //! end-of-step direction has no such limit.
 //!
-//! **Contacts.** After collision impulses, an island is projected again with each of
-//! its contacts as an inequality row `Σ cᵢ n·vᵢ ≥ target` (a point against an edge:
-//! the point's velocity minus the edge's at the contact point, along the normal).
-//! Each Newton step eliminates the edge unknowns through the island's factor (one
-//! solve per contact column), leaving a small contact-space complementarity problem,
-//! solved exactly by active-set pivoting (projected Gauss–Seidel finishes the
-//! projections pivoting does not settle). The edge equations hold exactly for any
-//! contact impulses, so lengths are exact whatever the contacts do; the contacts are
-//! met to the complementarity tolerance. Particles outside the island keep their velocities.
-//! With contacts the end-of-step direction is used, whatever the setting, since the
-//! elimination needs the symmetric system.
+//! **Contacts.** The islands that contact rows touch are projected together with
+//! those rows by [`project_jointly`] (`joint`, `joint_rows`): every island's edges met
+//! exactly, the rows to a tolerance, both sides of each contact moving.
 //!
 //! A pure kernel: slices in, slices out, no allocation once the scratch is sized. The
-//! loop is in `newton`, the assembly and solve of the system in `assembly`, the
-//! contact rows in `contact_rows` and their elimination in `elimination`.
+//! loop is in `newton`, the assembly and solve of the system in `assembly`.
 
 mod assembly;
 mod contact_rows;
-mod elimination;
+mod joint;
+mod joint_rows;
 mod newton;
 mod scratch;
 mod settings;
@@ -49,7 +41,8 @@ mod view;
 mod walk;
 
 pub use contact_rows::ContactRow;
-pub use scratch::{IslandScratch, MAX_CONTACT_ROWS};
+pub use joint::{JointOutcome, JointScratch, JointSettings, RowImpulse, project_jointly};
+pub use scratch::IslandScratch;
 pub use settings::{ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
 pub use view::{Bodies, Chain, Graph, IslandView};
 
@@ -57,67 +50,43 @@ use newton::project_walk;
 use walk::{ChainWalk, GraphWalk};
 
 /// Project the velocities of one chain so that every edge ends the step at its rest
-/// length, and no contact row falls below its target; see [`project_island`].
+/// length; see [`project_island`].
 pub fn project_chain(
     chain: Chain,
     bodies: Bodies,
-    contacts: &[ContactRow],
     dt: f64,
     settings: &ProjectionSettings,
     scratch: &mut IslandScratch,
 ) -> ProjectionOutcome {
-    project_island(
-        IslandView::Chain(chain),
-        bodies,
-        contacts,
-        dt,
-        settings,
-        scratch,
-    )
+    project_island(IslandView::Chain(chain), bodies, dt, settings, scratch)
 }
 
 /// Project the velocities of one island so that every edge ends the step at its rest
-/// length, and no contact row falls below its target. Only free particles of the
-/// island change velocity. Returns how the iteration ended; on a singular system the
+/// length. Only free particles of the island change velocity. Returns how the iteration ended; on a singular system the
 /// corrections found so far are applied. Trees and graphs always use the end-of-step
 /// direction: their sparse factorization needs the symmetric system.
 pub fn project_island(
     island: IslandView,
     bodies: Bodies,
-    contacts: &[ContactRow],
     dt: f64,
     settings: &ProjectionSettings,
     scratch: &mut IslandScratch,
 ) -> ProjectionOutcome {
     match island {
-        IslandView::Chain(Chain { edges, closed }) => project_walk(
-            edges,
-            ChainWalk { closed },
-            bodies,
-            contacts,
-            dt,
-            settings,
-            scratch,
-        ),
-        IslandView::Graph(Graph { edges, layout }) => project_walk(
-            edges,
-            GraphWalk { layout },
-            bodies,
-            contacts,
-            dt,
-            settings,
-            scratch,
-        ),
+        IslandView::Chain(Chain { edges, closed }) => {
+            project_walk(edges, ChainWalk { closed }, bodies, dt, settings, scratch)
+        }
+        IslandView::Graph(Graph { edges, layout }) => {
+            project_walk(edges, GraphWalk { layout }, bodies, dt, settings, scratch)
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::contact_rows::POLISH_RESIDUAL;
     use super::*;
     use crate::constraints::graph::GraphLayout;
     use crate::constraints::island_edge::IslandEdge;
-    use crate::model::PointEdgePair;
     use bevy::math::DVec2;
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
@@ -126,17 +95,11 @@ mod tests {
         IslandEdge::chain(points, closed)
     }
 
-    fn pair(p: usize, q: usize, r: usize, alpha: f64) -> PointEdgePair {
-        PointEdgePair { p, q, r, alpha }
-    }
-
     fn settings(direction: ConstraintDirection) -> ProjectionSettings {
         ProjectionSettings {
             tolerance: 1e-13,
             max_iterations: 50,
             direction,
-            contact_tolerance: 1e-12,
-            max_correction: f64::INFINITY,
         }
     }
 
@@ -145,7 +108,6 @@ mod tests {
         closed: bool,
         position: &'a [DVec2],
         inverse_mass: &'a [f64],
-        contacts: &'a [ContactRow],
         dt: f64,
     }
 
@@ -161,7 +123,6 @@ mod tests {
                     closed: self.closed,
                 },
                 Bodies::new(self.position, velocity, self.inverse_mass),
-                self.contacts,
                 self.dt,
                 &settings(direction),
                 &mut IslandScratch::default(),
@@ -228,7 +189,6 @@ mod tests {
                 closed,
                 position: &points,
                 inverse_mass: &inverse_mass,
-                contacts: &[],
                 dt: 1.0 / 3000.0,
             };
             // Start-of-step directions (SHAKE) need small displacements: see the module doc.
@@ -293,7 +253,6 @@ mod tests {
         project_island(
             IslandView::Graph(Graph { edges, layout }),
             Bodies::new(position, velocity, inverse_mass),
-            &[],
             1.0 / 3000.0,
             &settings(ConstraintDirection::EndOfStep),
             scratch,
@@ -346,7 +305,6 @@ mod tests {
                 closed: false,
                 position: &points,
                 inverse_mass: &inverse_mass,
-                contacts: &[],
                 dt: 1.0 / 3000.0,
             };
             let error = case.max_relative_error(&v);
@@ -406,7 +364,6 @@ mod tests {
             closed: false,
             position: &points,
             inverse_mass: &[1.0; 5],
-            contacts: &[],
             dt: 1.0 / 3000.0,
         };
         assert!(case.max_relative_error(&velocity) < 1e-12);
@@ -432,7 +389,6 @@ mod tests {
             closed: false,
             position: &points,
             inverse_mass: &inverse_mass,
-            contacts: &[],
             dt: 1.0 / 300.0,
         };
         let mut v = velocity.clone();
@@ -466,7 +422,6 @@ mod tests {
             closed: false,
             position: &points,
             inverse_mass: &[1.0; 3],
-            contacts: &[],
             dt: 0.01,
         };
         let mut v = [DVec2::ZERO, DVec2::ZERO, DVec2::new(3.0, 1.0)];
@@ -476,155 +431,5 @@ mod tests {
         assert!(v.iter().all(|v| v.is_finite()));
         let length = (points[2] + 0.01 * v[2]).distance(points[1] + 0.01 * v[1]);
         assert!((length - 1.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn contacts_hold_while_edges_stay_exact() {
-        // A strand lying on a floor, its first particle in contact (normal +y); the
-        // middle particle is kicked down or up, pulling the others along.
-        let n = 6;
-        let points: Vec<DVec2> = (0..n).map(|i| DVec2::new(0.1 * i as f64, 0.0)).collect();
-        let edges = chain_edges(&points, false);
-        let floor = n; // a pinned particle standing for the floor
-        let inverse_mass = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0];
-        for kick in [-2.0, 2.0] {
-            let mut velocity = vec![DVec2::ZERO; n + 1];
-            velocity[2] = DVec2::new(0.0, kick);
-            let contact = ContactRow::point_edge(pair(0, floor, floor, 0.0), DVec2::Y, &velocity);
-            let contacts = [contact];
-            let case = Case {
-                edges: &edges,
-                closed: false,
-                position: &points,
-                inverse_mass: &inverse_mass,
-                contacts: &contacts,
-                dt: 0.01,
-            };
-            let mut v = velocity.clone();
-            let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
-            assert!(outcome.converged, "{outcome:?}");
-            assert!(case.max_relative_error(&v) < 1e-12);
-            // Met up to the final edge polish: a millionth of an edge per step.
-            let polish = POLISH_RESIDUAL * 0.1 / case.dt;
-            assert!(contact.normal_velocity(&v) >= contact.target - polish);
-            if kick < 0.0 {
-                // Pulled down into the floor: the contact holds it.
-                assert!(v[0].y.abs() <= polish, "{}", v[0].y);
-            } else {
-                // Pulled up, away from the floor: the contact lets go.
-                assert!(v[0].y > 1e-6, "{}", v[0].y);
-            }
-        }
-    }
-
-    #[test]
-    fn a_strand_lying_on_another_is_held_by_a_relative_contact() {
-        // Strand A (particles 0..4, vertical) comes down onto strand B (5..9, flat):
-        // A's lowest particle touches B's edge (6, 7) halfway. Both are free, so the
-        // contact limits their relative motion, not either one's own.
-        let mut points: Vec<DVec2> = (0..5)
-            .map(|i| DVec2::new(0.43, 0.004 + 0.02 * i as f64))
-            .collect();
-        points.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
-        let upper = chain_edges(&points[..5], false);
-        let lower: Vec<IslandEdge> = chain_edges(&points[5..], false)
-            .into_iter()
-            .map(|e| IslandEdge {
-                a: e.a + 5,
-                b: e.b + 5,
-                ..e
-            })
-            .collect();
-        let mut velocity = vec![DVec2::ZERO; 10];
-        velocity[..5].fill(DVec2::new(0.3, -1.0));
-        velocity[1] = DVec2::new(0.3, -2.0); // compresses A's first edge: pushes 0 down
-        let contact = ContactRow::point_edge(pair(0, 6, 7, 0.5), DVec2::Y, &velocity);
-        // Without the contact, A's projection would drive particle 0 into B.
-        let mut free = velocity.clone();
-        let case = Case {
-            edges: &upper,
-            closed: false,
-            position: &points,
-            inverse_mass: &[1.0; 10],
-            contacts: &[],
-            dt: 0.01,
-        };
-        case.project(&mut free, ConstraintDirection::EndOfStep);
-        assert!(contact.normal_velocity(&free) < contact.target - 0.1);
-        // Each strand projected with the other frozen, as the island sweep does.
-        for chain in [&upper, &lower] {
-            let case = Case {
-                edges: chain,
-                closed: false,
-                position: &points,
-                inverse_mass: &[1.0; 10],
-                contacts: &[contact],
-                dt: 0.01,
-            };
-            let mut v = velocity.clone();
-            let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
-            assert!(outcome.converged, "{outcome:?}");
-            assert!(case.max_relative_error(&v) < 1e-12);
-            let polish = POLISH_RESIDUAL * 0.02 / case.dt;
-            assert!(contact.normal_velocity(&v) >= contact.target - polish);
-        }
-    }
-
-    #[test]
-    fn two_strands_in_contact_projected_together_meet_it_and_keep_their_momentum() {
-        // The two strands of the test above as one unit: one chain through both, joined
-        // by a locked gap edge. The contact impulse acts on both, equal and opposite,
-        // so the pair's momentum is what the predictor gave it.
-        let mut points: Vec<DVec2> = (0..5)
-            .map(|i| DVec2::new(0.43, 0.004 + 0.02 * i as f64))
-            .collect();
-        points.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
-        let mut unit = chain_edges(&points[..5], false);
-        unit.push(IslandEdge::gap(4, 5));
-        unit.extend(
-            chain_edges(&points[5..], false)
-                .into_iter()
-                .map(|e| IslandEdge {
-                    a: e.a + 5,
-                    b: e.b + 5,
-                    ..e
-                }),
-        );
-        let mut velocity = vec![DVec2::ZERO; 10];
-        velocity[..5].fill(DVec2::new(0.3, -1.0));
-        velocity[1] = DVec2::new(0.3, -2.0);
-        velocity[7] = DVec2::new(-0.2, 0.5); // B rises to meet A
-        let contact = ContactRow::point_edge(pair(0, 6, 7, 0.5), DVec2::Y, &velocity);
-        let inverse_mass: Vec<f64> = (0..10).map(|i| 1.0 / (1.0 + 0.1 * i as f64)).collect();
-        let case = Case {
-            edges: &unit,
-            closed: false,
-            position: &points,
-            inverse_mass: &inverse_mass,
-            contacts: &[contact],
-            dt: 0.01,
-        };
-        let mut v = velocity.clone();
-        let outcome = case.project(&mut v, ConstraintDirection::EndOfStep);
-        assert!(outcome.converged, "{outcome:?}");
-        assert_eq!(outcome.locked, 0, "the gap is not counted as a locked edge");
-        // The gap's "edge" is no constraint: only the real edges are measured.
-        let real: Vec<IslandEdge> = unit
-            .iter()
-            .copied()
-            .filter(|e| e.edge != IslandEdge::GAP)
-            .collect();
-        let measured = Case {
-            edges: &real,
-            ..case
-        };
-        assert!(measured.max_relative_error(&v) < 1e-12);
-        let polish = POLISH_RESIDUAL * 0.02 / case.dt;
-        assert!(contact.normal_velocity(&v) >= contact.target - polish);
-        let momentum =
-            |v: &[DVec2]| -> DVec2 { v.iter().zip(&inverse_mass).map(|(v, w)| *v / *w).sum() };
-        assert!((momentum(&v) - momentum(&velocity)).length() < 1e-12);
-        // Both strands moved: the contact pushed A up and B down.
-        assert!(v[0].y > velocity[0].y && v[6].y + v[7].y < velocity[6].y + velocity[7].y);
     }
 }

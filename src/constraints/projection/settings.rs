@@ -22,13 +22,6 @@ pub struct ProjectionSettings {
     pub max_iterations: u32,
     /// Where the constraint direction is evaluated.
     pub direction: ConstraintDirection,
-    /// How far (a distance per step) a contact row may fall short of its target.
-    pub contact_tolerance: f64,
-    /// Reject the projection (change nothing) if it would move any particle by more
-    /// than this fraction of the island's shortest rest length in one step; infinite
-    /// for no limit. Guards re-projections under contact, where nearly dependent
-    /// constraints can ask for absurd corrections.
-    pub max_correction: f64,
 }
 
 /// How a projection ended.
@@ -36,20 +29,17 @@ pub struct ProjectionSettings {
 pub struct ProjectionOutcome {
     /// Linear solves performed.
     pub iterations: u32,
-    /// Whether the edge tolerance was met. Contacts are met to their tolerance or as
-    /// well as the complementarity solve could: see `contact_violation`.
+    /// Whether the edge tolerance was met.
     pub converged: bool,
     /// Final `max |C_k| / L_k²`.
     pub residual: f64,
-    /// Final largest contact violation: how far (in distance per step) a contact row
-    /// falls short of its target.
-    pub contact_violation: f64,
     /// Whether a linear solve met a singular system; the velocities are then left as
     /// the last good iterate gives them.
     pub singular: bool,
     /// Edges of zero length, left as they are (they have no direction to act along).
     pub locked: u32,
-    /// Whether the corrections exceeded `max_correction` and were not applied.
+    /// Whether the corrections were too large to be applied (a joint projection's
+    /// guard) and were not.
     pub rejected: bool,
 }
 

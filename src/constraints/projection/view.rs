@@ -5,6 +5,7 @@ use bevy::math::DVec2;
 
 use crate::constraints::graph::GraphLayout;
 use crate::constraints::island_edge::IslandEdge;
+use crate::constraints::islands::{IslandKind, IslandSet};
 
 /// The particle slices a projection reads and writes.
 #[derive(Debug)]
@@ -63,4 +64,22 @@ pub enum IslandView<'a> {
     Chain(Chain<'a>),
     /// A tree or graph: a sparse LDLᵀ.
     Graph(Graph<'a>),
+}
+
+impl<'a> IslandView<'a> {
+    /// The view of island `island` of `set`.
+    pub fn of(set: &'a IslandSet, island: usize) -> IslandView<'a> {
+        let island = &set.islands[island];
+        let edges = &set.edges[island.edges.clone()];
+        match island.graph {
+            Some(g) => IslandView::Graph(Graph {
+                edges,
+                layout: &set.graphs[g],
+            }),
+            None => IslandView::Chain(Chain {
+                edges,
+                closed: island.kind == IslandKind::Cycle,
+            }),
+        }
+    }
 }

@@ -20,8 +20,6 @@ pub(super) trait Walk: Copy {
     /// The island edges at local particle `j`, with −1 where `j` starts the edge and +1
     /// where it ends it.
     fn for_incident(self, j: usize, m: usize, visit: impl FnMut(usize, f64));
-    /// The most island edges at one particle.
-    fn max_degree(self) -> usize;
     /// Whether the system must be the symmetric (end-of-step) one.
     fn symmetric_only(self) -> bool;
     /// Assemble and factor the system at the current iterate, and solve it for
@@ -33,7 +31,7 @@ pub(super) trait Walk: Copy {
         keep_factor: bool,
         s: &mut IslandScratch,
     ) -> Result<(), SingularPivot>;
-    /// Solve again with the kept factor, for `k` right-hand sides row by row.
+    /// Solve again with the kept factor `factors`, for `k` right-hand sides row by row.
     fn solve_many(self, m: usize, factors: &Factors, columns: &mut [f64], k: usize);
 }
 
@@ -71,10 +69,6 @@ impl Walk for ChainWalk {
         } else if self.closed {
             visit(m - 1, 1.0);
         }
-    }
-
-    fn max_degree(self) -> usize {
-        2
     }
 
     fn symmetric_only(self) -> bool {
@@ -126,10 +120,6 @@ impl Walk for GraphWalk<'_> {
         for &(k, sign) in self.layout.incident(j) {
             visit(k as usize, sign);
         }
-    }
-
-    fn max_degree(self) -> usize {
-        self.layout.max_degree
     }
 
     fn symmetric_only(self) -> bool {

@@ -1,0 +1,942 @@
+//! The joint projection: every island that a set of contact rows touches, projected
+//! together with those rows, both sides of every contact moving.
+//!
+//! The unknowns are the corrections Δ to the predicted end of step of the particles of
+//! the touched islands (and of loose free particles the rows touch). Each Newton step
+//! linearizes every island's edges at the current iterate and factors its own system
+//! `A = J W Jᵀ` (Thomas, Sherman–Morrison or sparse LDLᵀ, as the island's kind asks).
+//! The edges then hold, to first order, for any contact impulse: an impulse `f` on an
+//! island moves it by its *response* `r = W f − W Jᵀ A⁻¹ J W f`, the motion the
+//! island's linearized edges allow. The contact rows (normal and friction) are solved
+//! in contact space by projected Gauss–Seidel over those responses, so a contact
+//! between two strands pushes both, equal and opposite, each as a whole strand. The
+//! impulses are totals over the Newton steps, warm-started from the caller (the
+//! previous step's): a contact pushed too hard can let go.
+//!
+//! The contact rows are met to a tolerance, not to round-off: they keep pairs a
+//! cushion apart, and the collision stage verifies what they leave. The edges are met
+//! to round-off: once they are nearly met the rows are frozen and the last Newton
+//! steps polish the edges alone, converging quadratically.
+//!
+//! A response is kept in edge space (`A⁻¹ J W f`, one value per edge of the island),
+//! and the sweeps accumulate the islands' contact multipliers rather than particle
+//! motions: a row reads its three particles' corrections from them in a few products,
+//! and an impulse costs one pass over its islands' edges.
+
+use bevy::math::DVec2;
+
+use super::contact_rows::ContactRow;
+use super::joint_rows::{JointRow, Sweeps, localize_rows};
+use super::scratch::{Factors, IslandScratch};
+use super::settings::{ConstraintDirection, ProjectionSettings, ROUND_OFF_FLOOR};
+use super::view::{Bodies, IslandView};
+use super::walk::{ChainWalk, GraphWalk, Walk};
+use crate::constraints::island_edge::IslandEdge;
+use crate::constraints::islands::IslandSet;
+
+/// The total impulse a contact row applied (momentum): along its normal (never
+/// negative) and along its tangent (within the friction cone).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowImpulse {
+    /// Along the normal, pushing apart.
+    pub normal: f64,
+    /// Along the tangent `normal.perp()`.
+    pub tangent: f64,
+}
+
+/// How a joint projection is asked to stop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointSettings {
+    /// The edges' tolerance and the cap on Newton steps (the direction is always the
+    /// end-of-step one).
+    pub projection: ProjectionSettings,
+    /// Gauss–Seidel sweeps over the rows per Newton step, at most.
+    pub sweeps: u32,
+    /// How far (a distance per step) a normal row may fall short of its target.
+    pub contact_tolerance: f64,
+    /// A part whose corrections would move a particle by more than this many of its
+    /// shortest rest lengths keeps its velocities (infinite: no guard): nearly
+    /// dependent rows can ask for absurd corrections.
+    pub max_correction: f64,
+}
+
+/// How a joint projection ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointOutcome {
+    /// Newton steps.
+    pub iterations: u32,
+    /// Gauss–Seidel sweeps over the rows, summed over the Newton steps.
+    pub sweeps: u32,
+    /// Whether every island met its edges.
+    pub converged: bool,
+    /// Final `max |C_k| / L_k²` over every island.
+    pub residual: f64,
+    /// How far (a distance per step) the most violated normal row falls short.
+    pub contact_violation: f64,
+}
+
+/// One part of the joint problem: an island, or a loose free particle (no edges).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Part {
+    /// The island's position in the `islands` argument, or
+    /// [`LOOSE`].
+    pub(super) island: u32,
+    /// First joint particle and count.
+    pub(super) particles: (u32, u32),
+    /// First joint edge and count.
+    pub(super) edges: (u32, u32),
+    pub(super) shortest: f64,
+    pub(super) residual: f64,
+    /// A linear solve met a singular system in some Newton step.
+    pub(super) singular: bool,
+    /// Whether its factor in `part_factors` is good (the latest Newton step's).
+    pub(super) factored: bool,
+    /// Its corrections were absurd and were not applied.
+    pub(super) rejected: bool,
+}
+
+/// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
+/// polished alone (if the contact tolerance allows no less): the polish then moves
+/// particles by a few hundred-thousandths of an edge, and the sweeps no longer stir
+/// the edges.
+const JOINT_POLISH: f64 = 1e-4;
+
+/// Marks a part that is a loose particle.
+pub(super) const LOOSE: u32 = u32::MAX;
+
+/// Buffers of [`project_jointly`], reused from call to call.
+#[derive(Clone, Debug, Default)]
+pub struct JointScratch {
+    pub(super) parts: Vec<Part>,
+    /// Packed index of each joint particle.
+    pub(super) packed: Vec<u32>,
+    pub(super) inverse_mass: Vec<f64>,
+    /// The correction Δ of each joint particle.
+    pub(super) correction: Vec<DVec2>,
+    /// Δ at the start of the current Newton step.
+    pub(super) step_start: Vec<DVec2>,
+    /// Δ after the current Newton step's edge correction, before contacts.
+    pub(super) base: Vec<DVec2>,
+    /// Edges at each joint particle: `(joint edge, ±1)`, from `incident_start`.
+    pub(super) incident: Vec<(u32, f64)>,
+    pub(super) incident_start: Vec<u32>,
+    /// Joint ends of each joint edge.
+    pub(super) ends: Vec<(u32, u32)>,
+    pub(super) rest_squared: Vec<f64>,
+    pub(super) predicted_edge: Vec<DVec2>,
+    pub(super) edge: Vec<DVec2>,
+    pub(super) constraint: Vec<f64>,
+    pub(super) locked: Vec<bool>,
+    /// Edge multipliers of this Newton step's edge correction.
+    pub(super) edge_multiplier: Vec<f64>,
+    /// Contact multipliers `Σ dμ A⁻¹ J W f` of this Newton step, per joint edge.
+    pub(super) contact_multiplier: Vec<f64>,
+    /// Each joint edge's impulse over the projection (mass × length, tension positive).
+    pub(super) edge_impulse: Vec<f64>,
+    /// The packed → joint particle map (free particles of the parts only).
+    pub(super) joint_of: Vec<u32>,
+    pub(super) rows: Vec<JointRow>,
+    /// `(part, row, link)` of every row's link, by part.
+    pub(super) part_rows: Vec<(u32, u32, u32)>,
+    /// Responses in edge space, two per link (normal, tangent), `edges` values each.
+    pub(super) responses: Vec<f64>,
+    /// Responses per particle, two per link (normal, tangent), `particles` each.
+    pub(super) particle_responses: Vec<DVec2>,
+    pub(super) island: IslandScratch,
+    /// Each part's factor at the Newton step that last factored it.
+    pub(super) part_factors: Vec<Factors>,
+    /// Whether each part met its edges (by part), after the last call.
+    pub(super) met: Vec<bool>,
+}
+
+impl JointScratch {
+    /// After [`project_jointly`]: whether the island passed as `islands[i]` met its
+    /// edges (and had its corrections applied).
+    pub fn island_met(&self, i: usize) -> bool {
+        self.met.get(i).copied().unwrap_or(false)
+    }
+
+    /// After [`project_jointly`]: the impulse each edge of the island passed as
+    /// `islands[i]` carried (mass × length, tension positive), in the island's edge
+    /// order.
+    pub fn edge_impulses(&self, i: usize) -> &[f64] {
+        let (first, count) = self.parts[i].edges;
+        &self.edge_impulse[first as usize..(first + count) as usize]
+    }
+}
+
+/// Project `islands` and the `loose` free particles jointly with `rows`: every edge of
+/// every island ends the step at its rest length, and every row is met to the contact
+/// tolerance (normal rows never pulling, friction within the cone), both sides of each
+/// row moving. `impulses[c]` is row c's warm start on entry and its total impulse on
+/// return. Only free particles of the parts change velocity. Rows whose particles are
+/// all outside the parts are ignored.
+#[allow(clippy::too_many_arguments)]
+pub fn project_jointly(
+    set: &IslandSet,
+    islands: &[u32],
+    loose: &[u32],
+    bodies: Bodies,
+    rows: &[ContactRow],
+    impulses: &mut [RowImpulse],
+    dt: f64,
+    settings: &JointSettings,
+    scratch: &mut JointScratch,
+) -> JointOutcome {
+    let Bodies {
+        position,
+        velocity,
+        inverse_mass,
+    } = bodies;
+    lay_out(
+        set,
+        islands,
+        loose,
+        position,
+        velocity,
+        inverse_mass,
+        dt,
+        scratch,
+    );
+    localize_rows(rows, impulses, velocity, dt, scratch);
+    let outcome = iterate(set, islands, settings, scratch);
+    // Apply: a part whose corrections are absurd (nearly dependent rows asking for a
+    // lever's swing) keeps its velocities.
+    let limit = settings.max_correction;
+    let s = &mut *scratch;
+    s.met.clear();
+    for part in &mut s.parts {
+        let (first, count) = (part.particles.0 as usize, part.particles.1 as usize);
+        let corrections = &s.correction[first..first + count];
+        part.rejected = corrections
+            .iter()
+            .any(|c| !c.is_finite() || (limit.is_finite() && c.length() > limit * part.shortest));
+        let tolerance = settings.projection.tolerance.max(ROUND_OFF_FLOOR);
+        s.met
+            .push(!part.rejected && !part.singular && part.residual <= tolerance);
+        if part.rejected {
+            continue;
+        }
+        for (j, c) in (first..).zip(corrections) {
+            if s.inverse_mass[j] > 0.0 {
+                velocity[s.packed[j] as usize] += *c / dt;
+            }
+        }
+    }
+    for (row, impulse) in s.rows.iter().zip(impulses.iter_mut()) {
+        *impulse = RowImpulse {
+            normal: row.mu_n / dt,
+            tangent: row.mu_t / dt,
+        };
+    }
+    JointOutcome {
+        converged: s.met.iter().all(|&m| m),
+        ..outcome
+    }
+}
+
+/// Number the parts' particles and edges jointly and set up the Newton iteration.
+#[allow(clippy::too_many_arguments)]
+fn lay_out(
+    set: &IslandSet,
+    islands: &[u32],
+    loose: &[u32],
+    position: &[DVec2],
+    velocity: &[DVec2],
+    inverse_mass: &[f64],
+    dt: f64,
+    s: &mut JointScratch,
+) {
+    s.parts.clear();
+    s.packed.clear();
+    s.ends.clear();
+    s.rest_squared.clear();
+    s.predicted_edge.clear();
+    s.locked.clear();
+    s.incident.clear();
+    s.incident_start.clear();
+    for (i, &island) in islands.iter().enumerate() {
+        match IslandView::of(set, island as usize) {
+            IslandView::Chain(chain) => lay_out_island(
+                i as u32,
+                chain.edges,
+                ChainWalk {
+                    closed: chain.closed,
+                },
+                position,
+                velocity,
+                inverse_mass,
+                dt,
+                s,
+            ),
+            IslandView::Graph(graph) => lay_out_island(
+                i as u32,
+                graph.edges,
+                GraphWalk {
+                    layout: graph.layout,
+                },
+                position,
+                velocity,
+                inverse_mass,
+                dt,
+                s,
+            ),
+        }
+    }
+    for &p in loose {
+        let first = s.packed.len() as u32;
+        s.packed.push(p);
+        s.incident_start.push(s.incident.len() as u32);
+        s.parts.push(Part {
+            island: LOOSE,
+            particles: (first, 1),
+            edges: (s.ends.len() as u32, 0),
+            shortest: f64::INFINITY,
+            ..Default::default()
+        });
+    }
+    s.incident_start.push(s.incident.len() as u32);
+    let (n, m) = (s.packed.len(), s.ends.len());
+    s.inverse_mass.clear();
+    s.inverse_mass
+        .extend(s.packed.iter().map(|&p| inverse_mass[p as usize]));
+    for buffer in [&mut s.correction, &mut s.step_start, &mut s.base] {
+        buffer.clear();
+        buffer.resize(n, DVec2::ZERO);
+    }
+    s.edge.clear();
+    s.edge.resize(m, DVec2::ZERO);
+    for buffer in [
+        &mut s.constraint,
+        &mut s.edge_multiplier,
+        &mut s.contact_multiplier,
+        &mut s.edge_impulse,
+    ] {
+        buffer.clear();
+        buffer.resize(m, 0.0);
+    }
+    // Free particles only: a pinned particle may end several islands.
+    if s.joint_of.len() < inverse_mass.len() {
+        s.joint_of.resize(inverse_mass.len(), NOT_JOINT);
+    }
+    for (j, &p) in s.packed.iter().enumerate() {
+        if inverse_mass[p as usize] > 0.0 {
+            s.joint_of[p as usize] = j as u32;
+        }
+    }
+}
+
+/// Not a particle of the joint problem.
+pub(super) const NOT_JOINT: u32 = u32::MAX;
+
+#[allow(clippy::too_many_arguments)]
+fn lay_out_island<W: Walk>(
+    island: u32,
+    edges: &[IslandEdge],
+    walk: W,
+    position: &[DVec2],
+    velocity: &[DVec2],
+    inverse_mass: &[f64],
+    dt: f64,
+    s: &mut JointScratch,
+) {
+    let particles = walk.particles(edges);
+    let (first, first_edge) = (s.packed.len() as u32, s.ends.len() as u32);
+    for j in 0..particles {
+        s.packed.push(walk.particle(edges, j) as u32);
+    }
+    let mut shortest = f64::INFINITY;
+    for (k, e) in edges.iter().enumerate() {
+        let (a, b) = (e.a as usize, e.b as usize);
+        let (ja, jb) = walk.ends(k, particles);
+        s.ends.push((first + ja as u32, first + jb as u32));
+        let predicted = position[b] - position[a] + dt * (velocity[b] - velocity[a]);
+        s.predicted_edge.push(predicted);
+        s.rest_squared.push(e.rest_length * e.rest_length);
+        let w = inverse_mass[a] + inverse_mass[b];
+        s.locked.push(predicted.length_squared() * w <= 0.0);
+        shortest = shortest.min(e.rest_length);
+    }
+    for j in 0..particles {
+        s.incident_start.push(s.incident.len() as u32);
+        let incident = &mut s.incident;
+        walk.for_incident(j, edges.len(), |k, sign| {
+            incident.push((first_edge + k as u32, sign));
+        });
+    }
+    s.parts.push(Part {
+        island,
+        particles: (first, particles as u32),
+        edges: (first_edge, edges.len() as u32),
+        shortest,
+        ..Default::default()
+    });
+}
+
+/// The Newton iterations from Δ = 0 with the localized rows.
+fn iterate(
+    set: &IslandSet,
+    islands: &[u32],
+    settings: &JointSettings,
+    s: &mut JointScratch,
+) -> JointOutcome {
+    let projection = &settings.projection;
+    let tolerance = projection.tolerance.max(ROUND_OFF_FLOOR);
+    let contact_tolerance = settings.contact_tolerance;
+    let mut outcome = JointOutcome::default();
+    let mut rows_active = !s.rows.is_empty();
+    let mut previous_violation = f64::INFINITY;
+    let shortest = s
+        .parts
+        .iter()
+        .map(|p| p.shortest)
+        .fold(f64::INFINITY, f64::min);
+    let trust = 0.5 * shortest;
+    // The polish moves particles by about the residual times an edge: the rows are
+    // frozen only once that is inside the contact tolerance.
+    let polish = JOINT_POLISH.min(contact_tolerance / shortest);
+    loop {
+        let residual = measure_edges(s);
+        let violation = Sweeps::violation(s);
+        outcome.residual = residual;
+        outcome.contact_violation = violation;
+        // The rows are met, or met as well as the sweeps manage once that stops
+        // improving: freeze them, and polish the edges alone.
+        if rows_active
+            && outcome.iterations > 0
+            && residual <= polish
+            && (violation <= contact_tolerance || violation > 0.5 * previous_violation)
+        {
+            rows_active = false;
+        }
+        previous_violation = violation;
+        if residual <= tolerance && !rows_active {
+            break;
+        }
+        if outcome.iterations >= projection.max_iterations {
+            break;
+        }
+        outcome.iterations += 1;
+        s.step_start.copy_from_slice(&s.correction);
+        edge_step(set, islands, s);
+        if rows_active {
+            let first = outcome.iterations == 1;
+            outcome.sweeps +=
+                Sweeps::run(set, islands, s, first, settings.sweeps, contact_tolerance);
+        } else {
+            s.correction.copy_from_slice(&s.base);
+            s.contact_multiplier.fill(0.0);
+        }
+        // Trust region: the linearized edges allow any motion along themselves, and
+        // contacts met on that linearization can ask for a lever's swing the edges
+        // cannot follow; a shorter step re-linearizes.
+        let longest = s
+            .correction
+            .iter()
+            .zip(&s.step_start)
+            .map(|(c, start)| (*c - *start).length())
+            .fold(0.0f64, f64::max);
+        let shrink = if rows_active && longest > trust {
+            trust / longest
+        } else {
+            1.0
+        };
+        if shrink < 1.0 {
+            for (c, start) in s.correction.iter_mut().zip(&s.step_start) {
+                *c = *start + shrink * (*c - *start);
+            }
+            for row in &mut s.rows {
+                row.mu_n = row.start_n + shrink * (row.mu_n - row.start_n);
+                row.mu_t = row.start_t + shrink * (row.mu_t - row.start_t);
+            }
+        }
+        for k in 0..s.ends.len() {
+            let multiplier = s.edge_multiplier[k] - s.contact_multiplier[k];
+            s.edge_impulse[k] += shrink * -2.0 * multiplier * s.edge[k].length();
+        }
+    }
+    outcome
+}
+
+/// The edges at the current corrections, their constraint values and each part's
+/// residual; returns the largest.
+fn measure_edges(s: &mut JointScratch) -> f64 {
+    let mut largest = 0.0f64;
+    for part in &mut s.parts {
+        let (first, count) = (part.edges.0 as usize, part.edges.1 as usize);
+        let mut residual = 0.0f64;
+        for k in first..first + count {
+            let (a, b) = s.ends[k];
+            let d = s.predicted_edge[k] + (s.correction[b as usize] - s.correction[a as usize]);
+            s.edge[k] = d;
+            s.constraint[k] = d.length_squared() - s.rest_squared[k];
+            if !s.locked[k] {
+                residual = residual.max(s.constraint[k].abs() / s.rest_squared[k]);
+            }
+        }
+        part.residual = residual;
+        largest = largest.max(residual);
+    }
+    largest
+}
+
+/// Each part's Newton correction of its edges alone, into `s.base`, its factor kept
+/// for the rows' responses.
+fn edge_step(set: &IslandSet, islands: &[u32], s: &mut JointScratch) {
+    s.base.copy_from_slice(&s.correction);
+    if s.part_factors.len() < s.parts.len() {
+        s.part_factors.resize_with(s.parts.len(), Factors::default);
+    }
+    for p in 0..s.parts.len() {
+        let part = s.parts[p];
+        if part.island == LOOSE || part.edges.1 == 0 {
+            continue;
+        }
+        let solved = match IslandView::of(set, islands[part.island as usize] as usize) {
+            IslandView::Chain(chain) => solve_part(
+                p,
+                ChainWalk {
+                    closed: chain.closed,
+                },
+                s,
+            ),
+            IslandView::Graph(graph) => solve_part(
+                p,
+                GraphWalk {
+                    layout: graph.layout,
+                },
+                s,
+            ),
+        };
+        if !solved {
+            s.parts[p].singular = true;
+        }
+    }
+}
+
+/// Factor part `p`'s system at the current edges (kept in `s.part_factors[p]`) and
+/// solve its edge correction; false on a singular system (the part then moves only
+/// by its contacts' direct impulses this step).
+fn solve_part<W: Walk>(p: usize, walk: W, s: &mut JointScratch) -> bool {
+    let part = s.parts[p];
+    let (first, particles) = (part.particles.0 as usize, part.particles.1 as usize);
+    let (first_edge, m) = (part.edges.0 as usize, part.edges.1 as usize);
+    let island = &mut s.island;
+    island.reserve(m, particles);
+    island.inverse_mass[..particles].copy_from_slice(&s.inverse_mass[first..first + particles]);
+    island.edge[..m].copy_from_slice(&s.edge[first_edge..first_edge + m]);
+    island.locked[..m].copy_from_slice(&s.locked[first_edge..first_edge + m]);
+    for k in 0..m {
+        island.rhs[k] = if island.locked[k] {
+            0.0
+        } else {
+            -s.constraint[first_edge + k]
+        };
+    }
+    // Factor into the part's own storage.
+    std::mem::swap(&mut island.factors, &mut s.part_factors[p]);
+    let solved = walk.solve(m, ConstraintDirection::EndOfStep, true, island);
+    std::mem::swap(&mut island.factors, &mut s.part_factors[p]);
+    s.parts[p].factored = solved.is_ok();
+    if solved.is_err() {
+        s.edge_multiplier[first_edge..first_edge + m].fill(0.0);
+        return false;
+    }
+    s.edge_multiplier[first_edge..first_edge + m].copy_from_slice(&island.rhs[..m]);
+    for k in first_edge..first_edge + m {
+        let impulse = 2.0 * s.edge_multiplier[k] * s.edge[k];
+        let (a, b) = s.ends[k];
+        s.base[a as usize] -= s.inverse_mass[a as usize] * impulse;
+        s.base[b as usize] += s.inverse_mass[b as usize] * impulse;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraints::islands::find_islands;
+    use crate::model::{Edge, PointEdgePair};
+
+    /// A little world: points, edges joining `pairs`, pinned points.
+    struct World {
+        position: Vec<DVec2>,
+        inverse_mass: Vec<f64>,
+        set: IslandSet,
+    }
+
+    impl World {
+        fn new(position: Vec<DVec2>, pairs: &[(u32, u32)], pinned: &[usize]) -> World {
+            let mut inverse_mass = vec![1.0; position.len()];
+            for &p in pinned {
+                inverse_mass[p] = 0.0;
+            }
+            let edges: Vec<Edge> = pairs
+                .iter()
+                .map(|&(a, b)| {
+                    let length = position[a as usize].distance(position[b as usize]);
+                    Edge::new(a, b, length)
+                })
+                .collect();
+            let flags: Vec<bool> = inverse_mass.iter().map(|&w| w == 0.0).collect();
+            World {
+                set: find_islands(&edges, &flags),
+                position,
+                inverse_mass,
+            }
+        }
+
+        /// Project every island and the free particles in none with `rows`.
+        fn project(
+            &self,
+            velocity: &mut [DVec2],
+            rows: &[ContactRow],
+            impulses: &mut [RowImpulse],
+            dt: f64,
+            scratch: &mut JointScratch,
+        ) -> JointOutcome {
+            let islands: Vec<u32> = (0..self.set.islands.len() as u32).collect();
+            let in_island: Vec<u32> = self.set.edges.iter().flat_map(|e| [e.a, e.b]).collect();
+            let loose: Vec<u32> = (0..self.position.len() as u32)
+                .filter(|&p| self.inverse_mass[p as usize] > 0.0 && !in_island.contains(&p))
+                .collect();
+            project_jointly(
+                &self.set,
+                &islands,
+                &loose,
+                Bodies::new(&self.position, velocity, &self.inverse_mass),
+                rows,
+                impulses,
+                dt,
+                &settings(),
+                scratch,
+            )
+        }
+
+        fn max_relative_error(&self, velocity: &[DVec2], dt: f64) -> f64 {
+            let end = |i: u32| self.position[i as usize] + dt * velocity[i as usize];
+            self.set
+                .edges
+                .iter()
+                .map(|e| (end(e.b).distance(end(e.a)) - e.rest_length).abs() / e.rest_length)
+                .fold(0.0, f64::max)
+        }
+
+        fn momentum(&self, velocity: &[DVec2]) -> DVec2 {
+            (velocity.iter().zip(&self.inverse_mass))
+                .filter(|(_, w)| **w > 0.0)
+                .map(|(v, w)| *v / *w)
+                .sum()
+        }
+    }
+
+    const TOLERANCE: f64 = 1e-9;
+
+    fn settings() -> JointSettings {
+        JointSettings {
+            projection: ProjectionSettings {
+                tolerance: 1e-13,
+                max_iterations: 30,
+                direction: ConstraintDirection::EndOfStep,
+            },
+            sweeps: 200,
+            contact_tolerance: TOLERANCE,
+            max_correction: f64::INFINITY,
+        }
+    }
+
+    /// Point `p` against edge (q, r) at `alpha` along `normal`, asked to end the step
+    /// no closer than `gap` along it.
+    fn row(world: &World, pair: PointEdgePair, normal: DVec2, gap: f64, dt: f64) -> ContactRow {
+        let x = &world.position;
+        let start = normal.dot(x[pair.p] - x[pair.q].lerp(x[pair.r], pair.alpha));
+        let mut row = ContactRow::point_edge(pair, normal, &vec![DVec2::ZERO; x.len()]);
+        row.target = (gap - start) / dt;
+        row
+    }
+
+    fn pair(p: usize, q: usize, r: usize, alpha: f64) -> PointEdgePair {
+        PointEdgePair { p, q, r, alpha }
+    }
+
+    /// How far each row falls short of its target, as a distance per step.
+    fn shortfall(rows: &[ContactRow], velocity: &[DVec2], dt: f64) -> f64 {
+        rows.iter()
+            .map(|r| (r.target - r.normal_velocity(velocity)) * dt)
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn two_strands_in_contact_push_each_other_and_keep_their_momentum() {
+        // Strand A (0..5) hangs vertically with its lowest particle just above the
+        // middle of strand B (5..10), lying flat; A falls, B rises to meet it.
+        let mut position: Vec<DVec2> = (0..5)
+            .map(|i| DVec2::new(0.43, 0.006 + 0.02 * i as f64))
+            .collect();
+        position.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
+        let pairs = [
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 4),
+            (5, 6),
+            (6, 7),
+            (7, 8),
+            (8, 9),
+        ];
+        let world = World::new(position, &pairs, &[]);
+        let dt = 0.01;
+        let mut velocity = vec![DVec2::new(0.3, -1.0); 5];
+        velocity[1] = DVec2::new(0.3, -2.0);
+        velocity.extend([DVec2::new(-0.1, 0.4); 5]);
+        let rows = [row(&world, pair(0, 6, 7, 0.5), DVec2::Y, 0.004, dt)];
+        let before = velocity.clone();
+        let mut impulses = [RowImpulse::default()];
+        let outcome = world.project(
+            &mut velocity,
+            &rows,
+            &mut impulses,
+            dt,
+            &mut JointScratch::default(),
+        );
+        assert!(outcome.converged, "{outcome:?}");
+        assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+        assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+        assert!(impulses[0].normal > 0.0);
+        let (after, start) = (world.momentum(&velocity), world.momentum(&before));
+        assert!((after - start).length() < 1e-12, "{after} against {start}");
+        // Both moved: A held up, B pushed down.
+        assert!(velocity[0].y > before[0].y && velocity[6].y < before[6].y);
+    }
+
+    #[test]
+    fn a_contact_holds_a_strand_pushed_into_it_and_lets_go_of_one_pulled_away() {
+        // A strand lying on a floor (a pinned edge, particles 6 and 7), touching it at
+        // its first particle; its middle particle kicked down, or up.
+        let mut position: Vec<DVec2> = (0..6).map(|i| DVec2::new(0.1 * i as f64, 0.0)).collect();
+        position.extend([DVec2::new(-0.5, -0.004), DVec2::new(0.5, -0.004)]);
+        let pairs = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (6, 7)];
+        let world = World::new(position, &pairs, &[6, 7]);
+        let dt = 0.01;
+        for kick in [-2.0, 2.0] {
+            let mut velocity = vec![DVec2::ZERO; 8];
+            velocity[2] = DVec2::new(0.0, kick);
+            let rows = [row(&world, pair(0, 6, 7, 0.5), DVec2::Y, 0.004, dt)];
+            let mut impulses = [RowImpulse::default()];
+            let outcome = world.project(
+                &mut velocity,
+                &rows,
+                &mut impulses,
+                dt,
+                &mut JointScratch::default(),
+            );
+            assert!(outcome.converged, "{outcome:?}");
+            assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+            assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+            if kick < 0.0 {
+                assert!(impulses[0].normal > 0.0);
+                assert!(
+                    velocity[0].y.abs() * dt <= 2.0 * TOLERANCE,
+                    "{}",
+                    velocity[0].y
+                );
+            } else {
+                // Pulled up, away from the floor: the contact lets go.
+                assert_eq!(impulses[0].normal, 0.0);
+                assert!(velocity[0].y > 1e-6, "{}", velocity[0].y);
+            }
+        }
+    }
+
+    #[test]
+    fn friction_stops_sliding_inside_the_cone_and_slows_it_outside() {
+        // A loose particle pressed into a pinned floor edge while sliding along it:
+        // the normal impulse stops the approach, friction takes up to 0.3 of it off
+        // the sliding (Coulomb's law on the step's impulses).
+        let position = vec![
+            DVec2::new(0.0, 0.004),
+            DVec2::new(-1.0, 0.0),
+            DVec2::new(1.0, 0.0),
+        ];
+        let world = World::new(position, &[(1, 2)], &[1, 2]);
+        let dt = 0.01;
+        for (slide, sticks) in [(0.25, true), (0.5, false)] {
+            let mut velocity = vec![DVec2::new(slide, -1.0), DVec2::ZERO, DVec2::ZERO];
+            let mut rows = [row(&world, pair(0, 1, 2, 0.5), DVec2::Y, 0.004, dt)];
+            rows[0].friction = 0.3;
+            let mut impulses = [RowImpulse::default()];
+            world.project(
+                &mut velocity,
+                &rows,
+                &mut impulses,
+                dt,
+                &mut JointScratch::default(),
+            );
+            assert!((velocity[0].y * dt).abs() <= TOLERANCE);
+            assert!((impulses[0].normal - 1.0).abs() < 1e-6, "{:?}", impulses[0]);
+            if sticks {
+                assert!(velocity[0].x.abs() < 1e-6, "{}", velocity[0].x);
+            } else {
+                assert!((velocity[0].x - 0.2).abs() < 1e-6, "{}", velocity[0].x);
+                assert!((impulses[0].tangent.abs() - 0.3 * impulses[0].normal).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn a_particle_in_a_corner_gets_the_impulses_of_the_exact_contact_problem() {
+        // A loose particle driven into the corner of two pinned walls at 60° to each
+        // other: two rows that share it. Its contact problem is a 2 × 2 complementarity
+        // problem, solved here by trying each active set.
+        let corner = DVec2::ZERO;
+        let left = DVec2::from_angle(150f64.to_radians());
+        let right = DVec2::X;
+        let normals = [left.perp().normalize() * -1.0, right.perp()];
+        let x = corner + 0.01 * DVec2::new(-0.3, 1.0);
+        let position = vec![x, corner, corner + left, corner + right];
+        let world = World::new(position, &[(1, 2), (1, 3)], &[1, 2, 3]);
+        let dt = 0.01;
+        let push = -2.0 * (normals[0] + normals[1]);
+        let mut velocity = vec![push, DVec2::ZERO, DVec2::ZERO, DVec2::ZERO];
+        let rows: Vec<ContactRow> = [(2, normals[0]), (3, normals[1])]
+            .iter()
+            .map(|&(r, n)| {
+                let alpha = (x - corner).dot(world.position[r] - corner)
+                    / (world.position[r] - corner).length_squared();
+                row(&world, pair(0, 1, r, alpha), n, 0.004, dt)
+            })
+            .collect();
+        let mut impulses = [RowImpulse::default(); 2];
+        world.project(
+            &mut velocity,
+            &rows,
+            &mut impulses,
+            dt,
+            &mut JointScratch::default(),
+        );
+        // Brute force: S = N W Nᵀ (unit mass), q = N v − target.
+        let s = |a: usize, b: usize| rows[a].normal.dot(rows[b].normal);
+        let q: Vec<f64> = rows.iter().map(|r| r.normal.dot(push) - r.target).collect();
+        let mut best = None;
+        for active in 0..4u32 {
+            let on = |c: usize| active & (1 << c) != 0;
+            let mu = match (on(0), on(1)) {
+                (false, false) => [0.0, 0.0],
+                (true, false) => [-q[0] / s(0, 0), 0.0],
+                (false, true) => [0.0, -q[1] / s(1, 1)],
+                (true, true) => {
+                    let det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
+                    [
+                        (-q[0] * s(1, 1) + q[1] * s(0, 1)) / det,
+                        (-q[1] * s(0, 0) + q[0] * s(1, 0)) / det,
+                    ]
+                }
+            };
+            let w = [0, 1].map(|c| q[c] + s(c, 0) * mu[0] + s(c, 1) * mu[1]);
+            let feasible = (0..2).all(|c| mu[c] >= -1e-12 && w[c] >= -1e-12);
+            if feasible {
+                best = Some(mu);
+            }
+        }
+        let exact = best.expect("a solution");
+        for c in 0..2 {
+            assert!(
+                (impulses[c].normal - exact[c]).abs() < 1e-6,
+                "{impulses:?} against {exact:?}"
+            );
+        }
+        assert!(exact[0] > 0.0 && exact[1] > 0.0, "both walls push");
+    }
+
+    #[test]
+    fn a_tree_in_contact_keeps_every_edge_and_its_momentum() {
+        // A Y: a stem 0–1–2 forking at 2 into 3–4 and 5–6; a loose particle 7 falls
+        // onto the middle of edge 3–4.
+        let position = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(0.0, 0.05),
+            DVec2::new(0.0, 0.1),
+            DVec2::new(-0.04, 0.13),
+            DVec2::new(-0.08, 0.16),
+            DVec2::new(0.04, 0.13),
+            DVec2::new(0.08, 0.16),
+            DVec2::new(-0.06, 0.15),
+        ];
+        let pairs = [(0, 1), (1, 2), (2, 3), (3, 4), (2, 5), (5, 6)];
+        let world = World::new(position, &pairs, &[]);
+        let dt = 0.005;
+        let mut velocity = vec![DVec2::new(0.2, 0.1); 8];
+        velocity[7] = DVec2::new(0.3, -3.0);
+        let normal = (world.position[4] - world.position[3]).perp().normalize();
+        let normal = if normal.y < 0.0 { -normal } else { normal };
+        let rows = [row(&world, pair(7, 3, 4, 0.5), normal, 0.004, dt)];
+        let before = velocity.clone();
+        let mut impulses = [RowImpulse::default()];
+        let outcome = world.project(
+            &mut velocity,
+            &rows,
+            &mut impulses,
+            dt,
+            &mut JointScratch::default(),
+        );
+        assert!(outcome.converged, "{outcome:?}");
+        assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+        assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+        let (after, start) = (world.momentum(&velocity), world.momentum(&before));
+        assert!((after - start).length() < 1e-12, "{after} against {start}");
+    }
+
+    #[test]
+    fn the_impulses_returned_warm_start_the_same_problem_to_fewer_sweeps() {
+        // A strand lying across three pinned posts, pushed down onto them.
+        let mut position: Vec<DVec2> = (0..9).map(|i| DVec2::new(0.02 * i as f64, 0.004)).collect();
+        position.extend([
+            DVec2::new(0.03, 0.0),
+            DVec2::new(0.05, 0.0),
+            DVec2::new(0.11, 0.0),
+            DVec2::new(0.13, 0.0),
+        ]);
+        let pairs = [
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 4),
+            (4, 5),
+            (5, 6),
+            (6, 7),
+            (7, 8),
+            (9, 10),
+            (11, 12),
+        ];
+        let world = World::new(position, &pairs, &[9, 10, 11, 12]);
+        let dt = 0.002;
+        let start: Vec<DVec2> = (0..13)
+            .map(|i| {
+                if i < 9 {
+                    DVec2::new(0.1, -1.0 - 0.1 * i as f64)
+                } else {
+                    DVec2::ZERO
+                }
+            })
+            .collect();
+        let rows: Vec<ContactRow> = [(2, 9, 10), (6, 11, 12)]
+            .iter()
+            .map(|&(p, q, r)| row(&world, pair(p, q, r, 0.5), DVec2::Y, 0.004, dt))
+            .collect();
+        let mut scratch = JointScratch::default();
+        let mut cold = start.clone();
+        let mut impulses = vec![RowImpulse::default(); 2];
+        let first = world.project(&mut cold, &rows, &mut impulses, dt, &mut scratch);
+        let mut warm = start.clone();
+        let second = world.project(&mut warm, &rows, &mut impulses, dt, &mut scratch);
+        assert!(first.converged && second.converged);
+        assert!(second.sweeps < first.sweeps, "{second:?} against {first:?}");
+        for (a, b) in cold.iter().zip(&warm) {
+            assert!(
+                (*a - *b).length() * dt < 10.0 * TOLERANCE,
+                "{a} against {b}"
+            );
+        }
+        assert!(world.max_relative_error(&warm, dt) < 1e-12);
+    }
+}
