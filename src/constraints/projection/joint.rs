@@ -402,11 +402,13 @@ fn iterate(
         outcome.contact_violation = violation;
         // The rows are met, or met as well as the sweeps manage once that stops
         // improving: freeze them, and polish the edges alone.
-        if rows_active
-            && outcome.iterations > 0
-            && residual <= polish
-            && (violation <= contact_tolerance || violation > 0.5 * previous_violation)
-        {
+        let settled = residual <= polish
+            && (violation <= contact_tolerance || violation > 0.5 * previous_violation);
+        // Rows that keep the edges from settling in half the iterations (a large step
+        // whose linearized rows conflict with the edges) give way: the edges are met
+        // exactly, and the collision stage verifies what the rows could not hold.
+        let out_of_time = 2 * outcome.iterations >= projection.max_iterations;
+        if rows_active && outcome.iterations > 0 && (settled || out_of_time) {
             rows_active = false;
         }
         previous_violation = violation;

@@ -32,9 +32,11 @@ pub(super) struct JointRow {
     /// The totals at the start of the Newton step.
     pub(super) start_n: f64,
     pub(super) start_t: f64,
-    /// The row's own stiffness `N r` along the normal and the tangent.
+    /// The row's own stiffness `N r` along the normal and the tangent, and the
+    /// tangent's response to a normal impulse.
     diag_n: f64,
     diag_t: f64,
+    cross: f64,
     /// Whether its responses are computed (this projection).
     ready: bool,
     /// Each part the row touches: `(part, offset in particle responses, offset in
@@ -156,12 +158,12 @@ fn row_responses(set: &IslandSet, islands: &[u32], s: &mut JointScratch, c: usiz
             ),
         }
     }
-    let (diag_n, diag_t) = (
-        stiffness(s, c, Along::Normal),
-        stiffness(s, c, Along::Tangent),
-    );
+    let tangent = s.rows[c].normal.perp();
+    let diag_n = stiffness(s, c, Along::Normal, s.rows[c].normal);
+    let diag_t = stiffness(s, c, Along::Tangent, tangent);
+    let cross = stiffness(s, c, Along::Normal, tangent);
     let row = &mut s.rows[c];
-    (row.diag_n, row.diag_t, row.ready) = (diag_n, diag_t, true);
+    (row.diag_n, row.diag_t, row.cross, row.ready) = (diag_n, diag_t, cross, true);
 }
 
 /// Link `link` of row `c`: its part's responses, solved by `walk` with the part's
@@ -199,28 +201,29 @@ fn link_responses<W: Walk>(c: usize, link: usize, walk: Option<W>, s: &mut Joint
         }
         walk.solve_many(m, &s.part_factors[p as usize], columns, 2);
     }
-    for (along, direction) in [row.normal, row.normal.perp()].into_iter().enumerate() {
-        // r = W (f − Jᵀ y) over the part's particles.
-        let r = particle_offset + along * particles;
-        for local in 0..particles {
-            let j = first + local;
-            let range = s.incident_start[j] as usize..s.incident_start[j + 1] as usize;
-            let pull: DVec2 = s.incident[range]
-                .iter()
-                .filter(|&&(e, _)| !s.locked[e as usize])
-                .map(|&(e, sign)| {
-                    let y = s.responses[edge_offset + 2 * (e as usize - first_edge) + along];
-                    2.0 * sign * y * s.edge[e as usize]
-                })
-                .sum();
-            s.particle_responses[r + local] = -s.inverse_mass[j] * pull;
-        }
-        for &(j, coefficient) in &row.entries[..row.count as usize] {
-            if in_part(j) {
-                let local = j as usize - first;
-                s.particle_responses[r + local] +=
-                    s.inverse_mass[j as usize] * coefficient * direction;
-            }
+    // r = W (f − Jᵀ y) over the part's particles, edge by edge: an edge's multiplier
+    // pulls its start along it and its end back (a locked edge's is zero).
+    let (normal, tangent) = (row.normal, row.normal.perp());
+    let y = &s.responses[edge_offset..edge_offset + 2 * m];
+    let r = &mut s.particle_responses[particle_offset..particle_offset + 2 * particles];
+    r.fill(DVec2::ZERO);
+    let (r_n, r_t) = r.split_at_mut(particles);
+    for k in 0..m {
+        let (a, b) = s.ends[first_edge + k];
+        let (a, b) = (a as usize, b as usize);
+        let d = 2.0 * s.edge[first_edge + k];
+        let (y_n, y_t) = (y[2 * k], y[2 * k + 1]);
+        let (w_a, w_b) = (s.inverse_mass[a], s.inverse_mass[b]);
+        r_n[a - first] += w_a * y_n * d;
+        r_n[b - first] -= w_b * y_n * d;
+        r_t[a - first] += w_a * y_t * d;
+        r_t[b - first] -= w_b * y_t * d;
+    }
+    for &(j, coefficient) in &row.entries[..row.count as usize] {
+        if in_part(j) {
+            let (local, w) = (j as usize - first, s.inverse_mass[j as usize] * coefficient);
+            r_n[local] += w * normal;
+            r_t[local] += w * tangent;
         }
     }
 }
@@ -272,8 +275,7 @@ impl Sweeps {
                 if !row.ready {
                     row_responses(set, islands, s, c);
                 }
-                apply(s, c, Along::Normal, warm_n);
-                apply(s, c, Along::Tangent, warm_t);
+                apply(s, c, warm_n, warm_t);
             }
         }
         let mut sweeps = 0;
@@ -286,7 +288,7 @@ impl Sweeps {
                     continue;
                 }
                 let value = row.slack_n + moved(&s.correction, row, row.normal);
-                if value >= 0.0 && row.mu_n == 0.0 {
+                if value >= 0.0 && row.mu_n == 0.0 && row.mu_t == 0.0 {
                     continue; // met with no impulse: nothing to do
                 }
                 worst = worst.max(-value);
@@ -297,19 +299,22 @@ impl Sweeps {
                 if row.diag_n <= 0.0 {
                     continue;
                 }
+                // Normal first, then the tangent as the normal change leaves it (the
+                // two share one pass over the corrections).
                 let mu_n = (row.mu_n - value / row.diag_n).max(0.0);
-                let change = mu_n - row.mu_n;
-                s.rows[c].mu_n = mu_n;
-                apply(s, c, Along::Normal, change);
-                let row = &s.rows[c];
+                let change_n = mu_n - row.mu_n;
+                let mut change_t = 0.0;
                 if row.friction > 0.0 && row.diag_t > 0.0 && (mu_n > 0.0 || row.mu_t != 0.0) {
-                    let value = row.slack_t + moved(&s.correction, row, row.normal.perp());
+                    let value = row.slack_t
+                        + moved(&s.correction, row, row.normal.perp())
+                        + change_n * row.cross;
                     let cone = row.friction * mu_n;
-                    let mu_t = (row.mu_t - value / row.diag_t).clamp(-cone, cone);
-                    let change = mu_t - row.mu_t;
-                    s.rows[c].mu_t = mu_t;
-                    apply(s, c, Along::Tangent, change);
+                    change_t = (row.mu_t - value / row.diag_t).clamp(-cone, cone) - row.mu_t;
                 }
+                let row = &mut s.rows[c];
+                row.mu_n = mu_n;
+                row.mu_t += change_t;
+                apply(s, c, change_n, change_t);
             }
             if worst <= tolerance {
                 break;
@@ -344,13 +349,10 @@ fn particle_response(s: &JointScratch, c: usize, link: usize, along: Along) -> (
     (first, &s.particle_responses[start..start + particles])
 }
 
-/// Row `c`'s stiffness along `along`: `Σ cᵢ d·rᵢ` for its own unit impulse.
-fn stiffness(s: &JointScratch, c: usize, along: Along) -> f64 {
+/// `Σ cᵢ d·rᵢ` over row `c`'s particles for its responses `r` along `along`: its own
+/// stiffness with `d` the same direction, the cross term with the other.
+fn stiffness(s: &JointScratch, c: usize, along: Along, d: DVec2) -> f64 {
     let row = &s.rows[c];
-    let d = match along {
-        Along::Normal => row.normal,
-        Along::Tangent => row.normal.perp(),
-    };
     let mut value = 0.0;
     for link in 0..row.link_count as usize {
         let (first, r) = particle_response(s, c, link, along);
@@ -363,27 +365,23 @@ fn stiffness(s: &JointScratch, c: usize, along: Along) -> f64 {
     value
 }
 
-/// Add `amount` of row `c`'s impulse along `along` to the corrections.
-fn apply(s: &mut JointScratch, c: usize, along: Along, amount: f64) {
-    if amount == 0.0 {
+/// Add `normal` and `tangent` of row `c`'s impulses to the corrections.
+fn apply(s: &mut JointScratch, c: usize, normal: f64, tangent: f64) {
+    if normal == 0.0 && tangent == 0.0 {
         return;
     }
     for link in 0..s.rows[c].link_count as usize {
         let (part, offset, _) = s.rows[c].links[link];
         let (first, particles) = s.parts[part as usize].particles;
         let (first, particles) = (first as usize, particles as usize);
-        let start = offset as usize
-            + if along == Along::Tangent {
-                particles
-            } else {
-                0
-            };
+        let offset = offset as usize;
         let (correction, r) = (
             &mut s.correction[first..first + particles],
-            &s.particle_responses[start..start + particles],
+            &s.particle_responses[offset..offset + 2 * particles],
         );
-        for (x, r) in correction.iter_mut().zip(r) {
-            *x += amount * *r;
+        let (r_n, r_t) = r.split_at(particles);
+        for ((x, n), t) in correction.iter_mut().zip(r_n).zip(r_t) {
+            *x += normal * *n + tangent * *t;
         }
     }
 }
