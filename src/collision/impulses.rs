@@ -213,6 +213,21 @@ impl Collider<'_> {
         );
     }
 
+    /// The candidate pairs for the current velocities: those of the last search while
+    /// no particle's motion over the step has moved from the one it was searched with
+    /// by more than half the thickness (the edges' boxes were inflated by the
+    /// thickness, so every pair that can now touch was found), else a new search.
+    pub fn refresh_pairs(&mut self) {
+        let half = 0.5 * self.settings.thickness;
+        let searched = &self.scratch.displacement;
+        let moved = searched.len() != self.velocity.len()
+            || (self.velocity.iter().zip(searched))
+                .any(|(v, d)| (displacement(*v, self.dt) - *d).length_squared() > half * half);
+        if moved {
+            self.find_pairs();
+        }
+    }
+
     fn pair(&self, p: u32, k: u32, alpha: f64) -> PointEdgePair {
         let e = &self.edges[k as usize];
         PointEdgePair {
@@ -379,7 +394,7 @@ impl Collider<'_> {
         let mut outcome = CollisionOutcome::default();
         for _ in 0..self.settings.max_iterations {
             if stale {
-                self.find_pairs();
+                self.refresh_pairs();
             }
             let impulses = self.collision_pass();
             outcome.impulses += impulses;

@@ -37,6 +37,8 @@ pub struct Islands {
     joint: JointScratch,
     joint_islands: Vec<u32>,
     joint_loose: Vec<u32>,
+    /// Which islands (then which particles) the current joint projection takes.
+    joint_marks: Vec<bool>,
     lanes: Vec<Lane>,
     /// Each topology edge's impulse this step, summed over every projection of the
     /// step (mass × length, tension positive): see [`Islands::edge_tension`].
@@ -236,18 +238,34 @@ impl Islands {
         outcomes.clear();
         self.joint_islands.clear();
         self.joint_loose.clear();
+        // Each island and loose particle once (marked while collecting), so the lists
+        // never outgrow the islands and particles they were sized for.
+        self.joint_marks
+            .resize(self.set.islands.len() + island.len(), false);
+        let islands = self.set.islands.len();
         for row in rows {
             for &p in &row.particles {
-                match island_of(island, p as usize) {
-                    Some(i) => self.joint_islands.push(i as u32),
-                    None if bodies.inverse_mass[p as usize] > 0.0 => self.joint_loose.push(p),
-                    None => {}
+                let (slot, list, id) = match island_of(island, p as usize) {
+                    Some(i) => (i, &mut self.joint_islands, i as u32),
+                    None if bodies.inverse_mass[p as usize] > 0.0 => {
+                        (islands + p as usize, &mut self.joint_loose, p)
+                    }
+                    None => continue,
+                };
+                if !self.joint_marks[slot] {
+                    self.joint_marks[slot] = true;
+                    list.push(id);
                 }
             }
         }
+        for &i in &self.joint_islands {
+            self.joint_marks[i as usize] = false;
+        }
+        for &p in &self.joint_loose {
+            self.joint_marks[islands + p as usize] = false;
+        }
         for list in [&mut self.joint_islands, &mut self.joint_loose] {
             list.sort_unstable();
-            list.dedup();
         }
         if self.joint_islands.is_empty() && self.joint_loose.is_empty() {
             return JointOutcome {
@@ -410,6 +428,10 @@ pub fn rebuild_islands(
         }
     }
     islands.scratch.reserve(longest, most_particles);
+    let (count, particles) = (set.islands.len(), topology.pinned.len());
+    islands.joint_islands.reserve(count);
+    islands.joint_loose.reserve(particles);
+    islands.joint_marks.resize(count + particles, false);
     islands.relaxation.reserve(topology.pinned.len(), longest);
     topology.island.clear();
     topology.island.resize(topology.pinned.len(), NO_ISLAND);

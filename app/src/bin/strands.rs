@@ -42,7 +42,7 @@ struct RunArgs {
     /// Simulated seconds (default: the scene's duration).
     #[arg(long, value_name = "S")]
     seconds: Option<f64>,
-    /// Step size in seconds (default: the scene's, 1/600 for the built-in scenes, 1/3000 for the pile).
+    /// Step size in seconds (default: the scene's, 1/300 for the built-in scenes).
     #[arg(long, value_name = "DT")]
     dt: Option<f64>,
     /// Steps per tick (default: the scene's).
