@@ -77,6 +77,10 @@ fn collect_pairs(
     colliders: Query<&ColliderOf>,
     mut pairs: ResMut<TouchingPairs>,
 ) {
+    // As large as the contacts' buffer: it grows when that does, not at a later step.
+    let room = scratch.impulses.contacts.capacity();
+    let len = pairs.current.len();
+    pairs.current.reserve(room.saturating_sub(len));
     for contact in &scratch.impulses.contacts {
         let Some(edge) = topology.edges.get(contact.edge as usize) else {
             continue;

@@ -48,18 +48,26 @@ impl Plugin for ContactLoopPlugin {
 }
 
 /// The joint projection's settings: the constraint settings, with the contact loop's
-/// correction guard, tolerance and sweeps.
+/// correction guard, tolerance and sweeps. Rows give way after `give_way` of the Newton
+/// budget: the speculative solve holds its rows longer (9/10: it is the one that keeps
+/// strands apart), the contact loop's reprojection sooner (1/2: its rows come after a
+/// detected crossing, and the fail-safe is there when they cannot hold). Measured in
+/// docs/step-size.md: either share alone leaves more fail-safe steps at 1/120.
 fn joint_settings(
     contact: &ContactConfig,
     collisions: &CollisionConfig,
     constraints: &ConstraintConfig,
     dt: f64,
+    give_way: (u32, u32),
 ) -> JointSettings {
     JointSettings {
         projection: constraints.projection(),
         sweeps: contact.sweeps,
         contact_tolerance: contact.tolerance * collisions.thickness * dt,
         max_correction: contact.max_correction,
+        // At most the budget itself: the product cannot overflow in u64.
+        rows_give_way: (u64::from(constraints.max_iterations) * u64::from(give_way.0)
+            / u64::from(give_way.1.max(1))) as u32,
     }
 }
 
@@ -114,7 +122,7 @@ pub fn speculate(
     if !speculating(&collisions, &contact, &constraints) {
         return;
     }
-    let settings = joint_settings(&contact, &collisions, &constraints, step.dt);
+    let settings = joint_settings(&contact, &collisions, &constraints, step.dt, (9, 10));
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let thickness = collisions.thickness;
     let reach = contact.reach.max(1.0) * thickness;
@@ -174,6 +182,13 @@ pub fn speculate(
     // Remember the impulses for the next step's rows of the same pairs, and the
     // contacts that took one.
     buffers.warm.clear();
+    // As large as the keys' buffer: they grow when it does, not at a later step.
+    let room = buffers.keys.capacity();
+    buffers
+        .warm
+        .reserve(room.saturating_sub(buffers.warm.len()));
+    let speculated = &mut collider.scratch.speculated;
+    speculated.reserve(room.saturating_sub(speculated.len()));
     let rows = buffers
         .keys
         .iter()
@@ -232,7 +247,7 @@ pub fn contact_loop(
     if !(collisions.enabled && constraints.solver.projects_contacts() && contact.passes > 0) {
         return;
     }
-    let settings = joint_settings(&contact, &collisions, &constraints, step.dt);
+    let settings = joint_settings(&contact, &collisions, &constraints, step.dt, (1, 2));
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let scratch = &mut *scratch;
     let mut changed = scratch.outcome.impulses > 0;

@@ -62,10 +62,11 @@ fn steady_state_allocates_nothing(scenario: &str) {
         std::hint::black_box(Vec::<u8>::with_capacity(16));
     });
     assert_eq!(probe, 1);
-    // Warm up through first contact (2 s): the first ticks build the topology, the
-    // islands and the schedules; the first contacts size the collision buffers (at
-    // 1/600 branches' contacts still reach new peaks of rows in its second second).
-    for _ in 0..200 {
+    // Warm up through first contact (3 s): the first ticks build the topology, the
+    // islands and the schedules; the first contacts size the collision and contact
+    // buffers (long_strand's strands settling on each other reach their peak of
+    // contact rows a little after 2 s).
+    for _ in 0..300 {
         world.run_schedule(StrandsTick);
     }
     let steps = allocations_during(|| {

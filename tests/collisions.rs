@@ -43,10 +43,22 @@ fn a_fast_particle_does_not_tunnel_through_a_thin_pinned_edge() {
 
 #[test]
 fn strands_thrown_at_each_other_never_cross() {
+    // At every step size: the contact solve pushes both strands, so the momentum is
+    // kept (an earlier design solved rows between strands one side at a time and lost
+    // a third of it here at 1/600).
+    for (dt, substeps) in [
+        (1.0 / 3000.0, 30),
+        (1.0 / 600.0, 6),
+        (1.0 / 300.0, 3),
+        (1.0 / 60.0, 1),
+    ] {
+        thrown_at_each_other(dt, substeps);
+    }
+}
+
+fn thrown_at_each_other(dt: f64, substeps: u32) {
     let mut app = checked_app();
-    // At 1/600 a contact between two units solved one-sided once lost a third of the
-    // momentum here (speculative rows must stay inside a unit).
-    set_step(&mut app, 1.0 / 600.0, 6);
+    set_step(&mut app, dt, substeps);
     app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
     // Two strands crossing each other's paths at 20 units/s each, one tilted.
     let a = StrandBuilder::line(DVec2::new(0.1, 0.4), DVec2::Y, 20, 0.01)
@@ -66,23 +78,27 @@ fn strands_thrown_at_each_other_never_cross() {
             .sum()
     };
     let before = momentum(&app);
-    ticks(&mut app, 10);
-    assert_eq!(crossings(&app), 0);
+    let ticks_for_a_tenth = (0.1 / (dt * substeps as f64)).round() as usize;
+    ticks(&mut app, ticks_for_a_tenth);
+    assert_eq!(crossings(&app), 0, "dt {dt}");
     let metrics = app.world().resource::<StrandMetrics>();
-    assert!(metrics.contacts > 0, "they never met");
+    assert!(metrics.contacts > 0, "dt {dt}: they never met");
     assert!(
         metrics.max_rel_length_error < 1e-12,
-        "{:e}",
+        "dt {dt}: {:e}",
         metrics.max_rel_length_error
     );
     // The walls are absent: contact is internal, so momentum is conserved.
     let after = momentum(&app);
-    assert!((after - before).length() < 1e-10, "{before} → {after}");
+    assert!(
+        (after - before).length() < 1e-10,
+        "dt {dt}: {before} → {after}"
+    );
     // The contact took out most of the closing speed (inelastic, with friction).
     let mean_x = |s: Entity| strand_state(&app, s).iter().map(|(_, v)| v.x).sum::<f64>() / 20.0;
     assert!(
         mean_x(a) - mean_x(b) < 0.5 * 40.0,
-        "{} {}",
+        "dt {dt}: {} {}",
         mean_x(a),
         mean_x(b)
     );

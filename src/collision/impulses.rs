@@ -271,6 +271,13 @@ impl Collider<'_> {
     /// particles marked in contact.
     pub fn adopt_speculated(&mut self) {
         let scratch = &mut *self.scratch;
+        // As large as the speculated buffer: they grow when it does, not a step later.
+        let room = scratch.speculated.capacity();
+        scratch
+            .contacts
+            .reserve(room.saturating_sub(scratch.contacts.len()));
+        let len = scratch.contact_index.len();
+        scratch.contact_index.reserve(room.saturating_sub(len));
         for slot in 0..scratch.speculated.len() {
             let contact = scratch.speculated[slot];
             scratch.record(contact);

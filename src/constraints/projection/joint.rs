@@ -58,6 +58,10 @@ pub struct JointSettings {
     /// shortest rest lengths keeps its velocities (infinite: no guard): nearly
     /// dependent rows can ask for absurd corrections.
     pub max_correction: f64,
+    /// Rows that keep the edges from settling for this many Newton steps give way
+    /// (frozen, the edges polished alone in the steps left); the cap holds them
+    /// otherwise.
+    pub rows_give_way: u32,
 }
 
 /// How a joint projection ended.
@@ -404,10 +408,10 @@ fn iterate(
         // improving: freeze them, and polish the edges alone.
         let settled = residual <= polish
             && (violation <= contact_tolerance || violation > 0.5 * previous_violation);
-        // Rows that keep the edges from settling in half the iterations (a large step
-        // whose linearized rows conflict with the edges) give way: the edges are met
+        // Rows that keep the edges from settling for `rows_give_way` Newton steps (a large
+        // step whose linearized rows conflict with the edges) give way: the edges are met
         // exactly, and the collision stage verifies what the rows could not hold.
-        let out_of_time = 2 * outcome.iterations >= projection.max_iterations;
+        let out_of_time = outcome.iterations >= settings.rows_give_way;
         if rows_active && outcome.iterations > 0 && (settled || out_of_time) {
             rows_active = false;
         }
@@ -644,6 +648,7 @@ mod tests {
             sweeps: 200,
             contact_tolerance: TOLERANCE,
             max_correction: f64::INFINITY,
+            rows_give_way: 15,
         }
     }
 
