@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The long-run check: both factories for 100 s (or $SECONDS_TO_RUN) with the crossing
 # check at every step, their figures printed as a Markdown table. A crossing anywhere
-# makes the script exit non-zero. Each run takes about twenty minutes on two cores.
+# makes the script exit non-zero. Each run takes ten to twenty minutes on one core.
 #
 # Usage: scripts/long_runs.sh [seconds, default 100]
 set -euo pipefail

@@ -18,6 +18,10 @@ pub struct SingularPivot {
 /// Row `i` of `A` is `lower[i] x[i−1] + diagonal[i] x[i] + upper[i] x[i+1]`;
 /// `lower[0]` and `upper[n−1]` are ignored. `scratch` holds at least `n` values.
 /// Allocates nothing.
+///
+/// Eliminates from both ends at once and meets in the middle (a twisted
+/// factorization): Thomas' cost is the latency of its chain of divisions, one per
+/// row, and two independent chains of half the length overlap in the processor.
 pub fn solve_tridiagonal(
     lower: &[f64],
     diagonal: &[f64],
@@ -31,23 +35,87 @@ pub fn solve_tridiagonal(
     }
     debug_assert!(lower.len() >= n && diagonal.len() >= n && upper.len() >= n);
     debug_assert!(scratch.len() >= n);
-    // scratch[i] = c'_i, rhs[i] = d'_i.
-    let mut pivot = diagonal[0];
-    check_pivot(pivot, diagonal[0].abs() + upper[0].abs(), 0)?;
-    scratch[0] = upper[0] / pivot;
-    rhs[0] /= pivot;
-    for i in 1..n {
-        pivot = diagonal[i] - lower[i] * scratch[i - 1];
-        let scale =
-            lower[i].abs() + diagonal[i].abs() + if i + 1 < n { upper[i].abs() } else { 0.0 };
-        check_pivot(pivot, scale, i)?;
-        scratch[i] = if i + 1 < n { upper[i] / pivot } else { 0.0 };
-        rhs[i] = (rhs[i] - lower[i] * rhs[i - 1]) / pivot;
+    let (lower, diagonal, upper, scratch) =
+        (&lower[..n], &diagonal[..n], &upper[..n], &mut scratch[..n]);
+    let last = n - 1;
+    // Rows above `m` are eliminated downwards (x_i + scratch[i] x_{i+1} = rhs[i]), rows
+    // below it upwards (x_i + scratch[i] x_{i−1} = rhs[i]); row `m` meets both. A bad
+    // pivot only sets a flag: the loop stays free of branches, and a second pass over
+    // the pivots alone names the row.
+    let m = n / 2;
+    let pairs = last - m; // rows below the middle; the rows above are `m` >= `pairs`
+    let mut healthy = true;
+    let mut above = (0.0, 0.0); // (scratch, rhs) of the row just eliminated downwards
+    let mut below = (0.0, 0.0); // the same upwards
+    for k in 0..m {
+        let coupling = if k > 0 { lower[k] } else { 0.0 };
+        let pivot = diagonal[k] - coupling * above.0;
+        healthy &= usable(pivot, coupling.abs() + diagonal[k].abs() + upper[k].abs());
+        let inverse = 1.0 / pivot;
+        above = (upper[k] * inverse, (rhs[k] - coupling * above.1) * inverse);
+        (scratch[k], rhs[k]) = above;
+        if k < pairs {
+            let j = last - k;
+            let coupling = if k > 0 { upper[j] } else { 0.0 };
+            let pivot = diagonal[j] - coupling * below.0;
+            healthy &= usable(pivot, coupling.abs() + diagonal[j].abs() + lower[j].abs());
+            let inverse = 1.0 / pivot;
+            below = (lower[j] * inverse, (rhs[j] - coupling * below.1) * inverse);
+            (scratch[j], rhs[j]) = below;
+        }
     }
-    for i in (0..n - 1).rev() {
+    let from_above = if m > 0 { lower[m] } else { 0.0 };
+    let from_below = if pairs > 0 { upper[m] } else { 0.0 };
+    let pivot = diagonal[m] - from_above * above.0 - from_below * below.0;
+    healthy &= usable(
+        pivot,
+        from_above.abs() + diagonal[m].abs() + from_below.abs(),
+    );
+    if !healthy {
+        return Err(first_singular_row(lower, diagonal, upper));
+    }
+    rhs[m] = (rhs[m] - from_above * above.1 - from_below * below.1) / pivot;
+    // Back-substitution outwards from the middle, both halves together.
+    for k in 1..=m {
+        let i = m - k;
         rhs[i] -= scratch[i] * rhs[i + 1];
+        if k <= pairs {
+            let j = m + k;
+            rhs[j] -= scratch[j] * rhs[j - 1];
+        }
     }
     Ok(())
+}
+
+/// Whether a pivot is usable: finite and not negligible against its row.
+fn usable(pivot: f64, scale: f64) -> bool {
+    pivot.abs() > 1e-14 * scale && pivot.abs() < f64::INFINITY
+}
+
+/// The row at which [`solve_tridiagonal`]'s elimination broke down: its pivots again,
+/// in its order, without the right-hand side.
+fn first_singular_row(lower: &[f64], diagonal: &[f64], upper: &[f64]) -> SingularPivot {
+    let n = diagonal.len();
+    let (last, m) = (n - 1, n / 2);
+    let (mut above, mut below) = (0.0, 0.0);
+    for k in 0..m {
+        let coupling = if k > 0 { lower[k] } else { 0.0 };
+        let pivot = diagonal[k] - coupling * above;
+        if !usable(pivot, coupling.abs() + diagonal[k].abs() + upper[k].abs()) {
+            return SingularPivot { row: k };
+        }
+        above = upper[k] / pivot;
+        let j = last - k;
+        if j > m {
+            let coupling = if k > 0 { upper[j] } else { 0.0 };
+            let pivot = diagonal[j] - coupling * below;
+            if !usable(pivot, coupling.abs() + diagonal[j].abs() + lower[j].abs()) {
+                return SingularPivot { row: j };
+            }
+            below = lower[j] / pivot;
+        }
+    }
+    SingularPivot { row: m }
 }
 
 /// A tridiagonal matrix with its Thomas elimination stored, to solve many right-hand
@@ -129,7 +197,7 @@ impl TridiagonalFactor {
 }
 
 fn check_pivot(pivot: f64, scale: f64, row: usize) -> Result<(), SingularPivot> {
-    if pivot.is_finite() && pivot.abs() > 1e-14 * scale && pivot != 0.0 {
+    if usable(pivot, scale) {
         Ok(())
     } else {
         Err(SingularPivot { row })
@@ -314,5 +382,15 @@ pub(crate) mod tests {
             solve_tridiagonal(&lower, &diagonal, &upper, &mut x, &mut [0.0; 3]),
             Err(SingularPivot { row: 1 })
         );
+        // Either half's chain reports its own row.
+        for zero in 0..5 {
+            let mut diagonal = [2.0; 5];
+            diagonal[zero] = 0.0;
+            let mut x = [1.0; 5];
+            assert_eq!(
+                solve_tridiagonal(&[0.0; 5], &diagonal, &[0.0; 5], &mut x, &mut [0.0; 5]),
+                Err(SingularPivot { row: zero })
+            );
+        }
     }
 }
