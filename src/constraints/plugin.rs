@@ -88,7 +88,7 @@ impl Islands {
         if threads <= 1 || edges < PARALLEL_EDGES {
             for slot in 0..self.solved.len() {
                 let i = self.solved[slot];
-                self.project_island(i, bodies, dt, settings, stats);
+                self.project_alone(i, bodies, dt, settings, stats);
             }
             return;
         }
@@ -163,18 +163,6 @@ impl Islands {
         }
     }
 
-    /// Project island `island` alone, with no contact rows; whether it met its edges.
-    pub fn project_alone(
-        &mut self,
-        island: usize,
-        bodies: &mut Bodies,
-        dt: f64,
-        settings: &ProjectionSettings,
-        stats: &mut IterationStats,
-    ) -> bool {
-        self.project_island(island, bodies, dt, settings, stats)
-    }
-
     /// Relax every solved island (the Constrain stage of the baseline solvers),
     /// recording each solve.
     pub fn relax(
@@ -199,7 +187,8 @@ impl Islands {
         }
     }
 
-    fn project_island(
+    /// Project island `island` alone, with no contact rows; whether it met its edges.
+    pub fn project_alone(
         &mut self,
         island: usize,
         bodies: &mut Bodies,

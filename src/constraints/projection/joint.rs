@@ -18,31 +18,22 @@
 //! to round-off: once they are nearly met the rows are frozen and the last Newton
 //! steps polish the edges alone, converging quadratically.
 //!
-//! A response is kept in edge space (`A⁻¹ J W f`, one value per edge of the island),
-//! and the sweeps accumulate the islands' contact multipliers rather than particle
-//! motions: a row reads its three particles' corrections from them in a few products,
-//! and an impulse costs one pass over its islands' edges.
+//! A response is kept twice (`joint_rows`): per particle, which the sweeps add to the
+//! corrections when a row's impulse changes, and per edge (`A⁻¹ J W f`), summed once
+//! per Newton step into the edges' contact multipliers. The state both work on is in
+//! `joint_state`.
 
 use bevy::math::DVec2;
 
 use super::contact_rows::ContactRow;
-use super::joint_rows::{JointRow, Sweeps, localize_rows};
-use super::scratch::{Factors, IslandScratch};
+use super::joint_rows::{Sweeps, localize_rows};
+use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part, RowImpulse};
+use super::scratch::Factors;
 use super::settings::{ConstraintDirection, ProjectionSettings, ROUND_OFF_FLOOR};
 use super::view::{Bodies, IslandView};
 use super::walk::{ChainWalk, GraphWalk, Walk};
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::islands::IslandSet;
-
-/// The total impulse a contact row applied (momentum): along its normal (never
-/// negative) and along its tangent (within the friction cone).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RowImpulse {
-    /// Along the normal, pushing apart.
-    pub normal: f64,
-    /// Along the tangent `normal.perp()`.
-    pub tangent: f64,
-}
 
 /// How a joint projection is asked to stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,95 +70,11 @@ pub struct JointOutcome {
     pub contact_violation: f64,
 }
 
-/// One part of the joint problem: an island, or a loose free particle (no edges).
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Part {
-    /// The island's position in the `islands` argument, or
-    /// [`LOOSE`].
-    pub(super) island: u32,
-    /// First joint particle and count.
-    pub(super) particles: (u32, u32),
-    /// First joint edge and count.
-    pub(super) edges: (u32, u32),
-    pub(super) shortest: f64,
-    pub(super) residual: f64,
-    /// A linear solve met a singular system in some Newton step.
-    pub(super) singular: bool,
-    /// Whether its factor in `part_factors` is good (the latest Newton step's).
-    pub(super) factored: bool,
-    /// Its corrections were absurd and were not applied.
-    pub(super) rejected: bool,
-}
-
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
 /// polished alone (if the contact tolerance allows no less): the polish then moves
 /// particles by a few hundred-thousandths of an edge, and the sweeps no longer stir
 /// the edges.
 const JOINT_POLISH: f64 = 1e-4;
-
-/// Marks a part that is a loose particle.
-pub(super) const LOOSE: u32 = u32::MAX;
-
-/// Buffers of [`project_jointly`], reused from call to call.
-#[derive(Clone, Debug, Default)]
-pub struct JointScratch {
-    pub(super) parts: Vec<Part>,
-    /// Packed index of each joint particle.
-    pub(super) packed: Vec<u32>,
-    pub(super) inverse_mass: Vec<f64>,
-    /// The correction Δ of each joint particle.
-    pub(super) correction: Vec<DVec2>,
-    /// Δ at the start of the current Newton step.
-    pub(super) step_start: Vec<DVec2>,
-    /// Δ after the current Newton step's edge correction, before contacts.
-    pub(super) base: Vec<DVec2>,
-    /// Edges at each joint particle: `(joint edge, ±1)`, from `incident_start`.
-    pub(super) incident: Vec<(u32, f64)>,
-    pub(super) incident_start: Vec<u32>,
-    /// Joint ends of each joint edge.
-    pub(super) ends: Vec<(u32, u32)>,
-    pub(super) rest_squared: Vec<f64>,
-    pub(super) predicted_edge: Vec<DVec2>,
-    pub(super) edge: Vec<DVec2>,
-    pub(super) constraint: Vec<f64>,
-    pub(super) locked: Vec<bool>,
-    /// Edge multipliers of this Newton step's edge correction.
-    pub(super) edge_multiplier: Vec<f64>,
-    /// Contact multipliers `Σ dμ A⁻¹ J W f` of this Newton step, per joint edge.
-    pub(super) contact_multiplier: Vec<f64>,
-    /// Each joint edge's impulse over the projection (mass × length, tension positive).
-    pub(super) edge_impulse: Vec<f64>,
-    /// The packed → joint particle map (free particles of the parts only).
-    pub(super) joint_of: Vec<u32>,
-    pub(super) rows: Vec<JointRow>,
-    /// `(part, row, link)` of every row's link, by part.
-    pub(super) part_rows: Vec<(u32, u32, u32)>,
-    /// Responses in edge space, two per link (normal, tangent), `edges` values each.
-    pub(super) responses: Vec<f64>,
-    /// Responses per particle, two per link (normal, tangent), `particles` each.
-    pub(super) particle_responses: Vec<DVec2>,
-    pub(super) island: IslandScratch,
-    /// Each part's factor at the Newton step that last factored it.
-    pub(super) part_factors: Vec<Factors>,
-    /// Whether each part met its edges (by part), after the last call.
-    pub(super) met: Vec<bool>,
-}
-
-impl JointScratch {
-    /// After [`project_jointly`]: whether the island passed as `islands[i]` met its
-    /// edges (and had its corrections applied).
-    pub fn island_met(&self, i: usize) -> bool {
-        self.met.get(i).copied().unwrap_or(false)
-    }
-
-    /// After [`project_jointly`]: the impulse each edge of the island passed as
-    /// `islands[i]` carried (mass × length, tension positive), in the island's edge
-    /// order.
-    pub fn edge_impulses(&self, i: usize) -> &[f64] {
-        let (first, count) = self.parts[i].edges;
-        &self.edge_impulse[first as usize..(first + count) as usize]
-    }
-}
 
 /// Project `islands` and the `loose` free particles jointly with `rows`: every edge of
 /// every island ends the step at its rest length, and every row is met to the contact
@@ -329,9 +236,6 @@ fn lay_out(
         }
     }
 }
-
-/// Not a particle of the joint problem.
-pub(super) const NOT_JOINT: u32 = u32::MAX;
 
 #[allow(clippy::too_many_arguments)]
 fn lay_out_island<W: Walk>(
@@ -619,6 +523,21 @@ mod tests {
             )
         }
 
+        /// Project with fresh buffers; the projection converged, every edge is exact
+        /// and every row is met.
+        fn project_and_check(
+            &self,
+            velocity: &mut [DVec2],
+            rows: &[ContactRow],
+            impulses: &mut [RowImpulse],
+            dt: f64,
+        ) {
+            let outcome = self.project(velocity, rows, impulses, dt, &mut JointScratch::default());
+            assert!(outcome.converged, "{outcome:?}");
+            assert!(self.max_relative_error(velocity, dt) < 1e-12);
+            assert!(shortfall(rows, velocity, dt) <= TOLERANCE);
+        }
+
         fn max_relative_error(&self, velocity: &[DVec2], dt: f64) -> f64 {
             let end = |i: u32| self.position[i as usize] + dt * velocity[i as usize];
             self.set
@@ -699,16 +618,7 @@ mod tests {
         let rows = [row(&world, pair(0, 6, 7, 0.5), DVec2::Y, 0.004, dt)];
         let before = velocity.clone();
         let mut impulses = [RowImpulse::default()];
-        let outcome = world.project(
-            &mut velocity,
-            &rows,
-            &mut impulses,
-            dt,
-            &mut JointScratch::default(),
-        );
-        assert!(outcome.converged, "{outcome:?}");
-        assert!(world.max_relative_error(&velocity, dt) < 1e-12);
-        assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+        world.project_and_check(&mut velocity, &rows, &mut impulses, dt);
         assert!(impulses[0].normal > 0.0);
         let (after, start) = (world.momentum(&velocity), world.momentum(&before));
         assert!((after - start).length() < 1e-12, "{after} against {start}");
@@ -730,16 +640,7 @@ mod tests {
             velocity[2] = DVec2::new(0.0, kick);
             let rows = [row(&world, pair(0, 6, 7, 0.5), DVec2::Y, 0.004, dt)];
             let mut impulses = [RowImpulse::default()];
-            let outcome = world.project(
-                &mut velocity,
-                &rows,
-                &mut impulses,
-                dt,
-                &mut JointScratch::default(),
-            );
-            assert!(outcome.converged, "{outcome:?}");
-            assert!(world.max_relative_error(&velocity, dt) < 1e-12);
-            assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+            world.project_and_check(&mut velocity, &rows, &mut impulses, dt);
             if kick < 0.0 {
                 assert!(impulses[0].normal > 0.0);
                 assert!(
@@ -879,16 +780,7 @@ mod tests {
         let rows = [row(&world, pair(7, 3, 4, 0.5), normal, 0.004, dt)];
         let before = velocity.clone();
         let mut impulses = [RowImpulse::default()];
-        let outcome = world.project(
-            &mut velocity,
-            &rows,
-            &mut impulses,
-            dt,
-            &mut JointScratch::default(),
-        );
-        assert!(outcome.converged, "{outcome:?}");
-        assert!(world.max_relative_error(&velocity, dt) < 1e-12);
-        assert!(shortfall(&rows, &velocity, dt) <= TOLERANCE);
+        world.project_and_check(&mut velocity, &rows, &mut impulses, dt);
         let (after, start) = (world.momentum(&velocity), world.momentum(&before));
         assert!((after - start).length() < 1e-12, "{after} against {start}");
     }

@@ -9,41 +9,10 @@
 use bevy::math::DVec2;
 
 use super::contact_rows::ContactRow;
-use super::joint::{JointScratch, LOOSE, NOT_JOINT, RowImpulse};
+use super::joint_state::{JointRow, JointScratch, LOOSE, NOT_JOINT, RowImpulse};
 use super::view::IslandView;
 use super::walk::{ChainWalk, GraphWalk, Walk};
 use crate::constraints::islands::IslandSet;
-
-/// A contact row in joint terms. Its normal part `Σ cᵢ n·(v + Δᵢ/dt) ≥ target` reads
-/// `slack_n + Σ cᵢ n·Δᵢ ≥ 0`; its tangent part asks for no sliding, `slack_t +
-/// Σ cᵢ t·Δᵢ = 0`, with an impulse no larger than `friction` times the normal one.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct JointRow {
-    /// `(joint particle, coefficient)` of each free particle.
-    entries: [(u32, f64); 3],
-    count: u8,
-    normal: DVec2,
-    slack_n: f64,
-    slack_t: f64,
-    friction: f64,
-    /// Total impulses so far, times dt (mass × length).
-    pub(super) mu_n: f64,
-    pub(super) mu_t: f64,
-    /// The totals at the start of the Newton step.
-    pub(super) start_n: f64,
-    pub(super) start_t: f64,
-    /// The row's own stiffness `N r` along the normal and the tangent, and the
-    /// tangent's response to a normal impulse.
-    diag_n: f64,
-    diag_t: f64,
-    cross: f64,
-    /// Whether its responses are computed (this projection).
-    ready: bool,
-    /// Each part the row touches: `(part, offset in particle responses, offset in
-    /// edge responses)`.
-    links: [(u32, u32, u32); 2],
-    link_count: u8,
-}
 
 /// Translate `rows` into joint rows (one each, in order; a row with no free particle
 /// among the parts stays inert), warm-started from `impulses`.

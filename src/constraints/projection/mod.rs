@@ -34,6 +34,7 @@ mod assembly;
 mod contact_rows;
 mod joint;
 mod joint_rows;
+mod joint_state;
 mod newton;
 mod scratch;
 mod settings;
@@ -41,7 +42,8 @@ mod view;
 mod walk;
 
 pub use contact_rows::ContactRow;
-pub use joint::{JointOutcome, JointScratch, JointSettings, RowImpulse, project_jointly};
+pub use joint::{JointOutcome, JointSettings, project_jointly};
+pub use joint_state::{JointScratch, RowImpulse};
 pub use scratch::IslandScratch;
 pub use settings::{ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
 pub use view::{Bodies, Chain, Graph, IslandView};

@@ -1,0 +1,133 @@
+//! The joint projection's state: its parts, its rows in joint terms and the buffers
+//! both the Newton iterations (`joint`) and the rows' sweeps (`joint_rows`) work on.
+
+use bevy::math::DVec2;
+
+use super::scratch::{Factors, IslandScratch};
+
+/// The total impulse a contact row applied (momentum): along its normal (never
+/// negative) and along its tangent (within the friction cone).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowImpulse {
+    /// Along the normal, pushing apart.
+    pub normal: f64,
+    /// Along the tangent `normal.perp()`.
+    pub tangent: f64,
+}
+
+/// One part of the joint problem: an island, or a loose free particle (no edges).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Part {
+    /// The island's position in the `islands` argument, or [`LOOSE`].
+    pub(super) island: u32,
+    /// First joint particle and count.
+    pub(super) particles: (u32, u32),
+    /// First joint edge and count.
+    pub(super) edges: (u32, u32),
+    pub(super) shortest: f64,
+    pub(super) residual: f64,
+    /// A linear solve met a singular system in some Newton step.
+    pub(super) singular: bool,
+    /// Whether its factor in `part_factors` is good (the latest Newton step's).
+    pub(super) factored: bool,
+    /// Its corrections were absurd and were not applied.
+    pub(super) rejected: bool,
+}
+
+/// Marks a part that is a loose particle.
+pub(super) const LOOSE: u32 = u32::MAX;
+
+/// Not a particle of the joint problem.
+pub(super) const NOT_JOINT: u32 = u32::MAX;
+
+/// A contact row in joint terms. Its normal part `Σ cᵢ n·(v + Δᵢ/dt) ≥ target` reads
+/// `slack_n + Σ cᵢ n·Δᵢ ≥ 0`; its tangent part asks for no sliding, `slack_t +
+/// Σ cᵢ t·Δᵢ = 0`, with an impulse no larger than `friction` times the normal one.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct JointRow {
+    /// `(joint particle, coefficient)` of each free particle.
+    pub(super) entries: [(u32, f64); 3],
+    pub(super) count: u8,
+    pub(super) normal: DVec2,
+    pub(super) slack_n: f64,
+    pub(super) slack_t: f64,
+    pub(super) friction: f64,
+    /// Total impulses so far, times dt (mass × length).
+    pub(super) mu_n: f64,
+    pub(super) mu_t: f64,
+    /// The totals at the start of the Newton step.
+    pub(super) start_n: f64,
+    pub(super) start_t: f64,
+    /// The row's own stiffness `N r` along the normal and the tangent, and the
+    /// tangent's response to a normal impulse.
+    pub(super) diag_n: f64,
+    pub(super) diag_t: f64,
+    pub(super) cross: f64,
+    /// Whether its responses are computed (this projection).
+    pub(super) ready: bool,
+    /// Each part the row touches: `(part, offset in particle responses, offset in
+    /// edge responses)`.
+    pub(super) links: [(u32, u32, u32); 2],
+    pub(super) link_count: u8,
+}
+
+/// Buffers of [`project_jointly`](super::project_jointly), reused from call to call.
+#[derive(Clone, Debug, Default)]
+pub struct JointScratch {
+    pub(super) parts: Vec<Part>,
+    /// Packed index of each joint particle.
+    pub(super) packed: Vec<u32>,
+    pub(super) inverse_mass: Vec<f64>,
+    /// The correction Δ of each joint particle.
+    pub(super) correction: Vec<DVec2>,
+    /// Δ at the start of the current Newton step.
+    pub(super) step_start: Vec<DVec2>,
+    /// Δ after the current Newton step's edge correction, before contacts.
+    pub(super) base: Vec<DVec2>,
+    /// Edges at each joint particle: `(joint edge, ±1)`, from `incident_start`.
+    pub(super) incident: Vec<(u32, f64)>,
+    pub(super) incident_start: Vec<u32>,
+    /// Joint ends of each joint edge.
+    pub(super) ends: Vec<(u32, u32)>,
+    pub(super) rest_squared: Vec<f64>,
+    pub(super) predicted_edge: Vec<DVec2>,
+    pub(super) edge: Vec<DVec2>,
+    pub(super) constraint: Vec<f64>,
+    pub(super) locked: Vec<bool>,
+    /// Edge multipliers of this Newton step's edge correction.
+    pub(super) edge_multiplier: Vec<f64>,
+    /// Contact multipliers `Σ dμ A⁻¹ J W f` of this Newton step, per joint edge.
+    pub(super) contact_multiplier: Vec<f64>,
+    /// Each joint edge's impulse over the projection (mass × length, tension positive).
+    pub(super) edge_impulse: Vec<f64>,
+    /// The packed → joint particle map (free particles of the parts only).
+    pub(super) joint_of: Vec<u32>,
+    pub(super) rows: Vec<JointRow>,
+    /// `(part, row, link)` of every row's link, by part.
+    pub(super) part_rows: Vec<(u32, u32, u32)>,
+    /// Responses in edge space, two per link (normal, tangent), `edges` values each.
+    pub(super) responses: Vec<f64>,
+    /// Responses per particle, two per link (normal, tangent), `particles` each.
+    pub(super) particle_responses: Vec<DVec2>,
+    pub(super) island: IslandScratch,
+    /// Each part's factor at the Newton step that last factored it.
+    pub(super) part_factors: Vec<Factors>,
+    /// Whether each part met its edges (by part), after the last call.
+    pub(super) met: Vec<bool>,
+}
+
+impl JointScratch {
+    /// After [`project_jointly`](super::project_jointly): whether the island passed as `islands[i]` met its
+    /// edges (and had its corrections applied).
+    pub fn island_met(&self, i: usize) -> bool {
+        self.met.get(i).copied().unwrap_or(false)
+    }
+
+    /// After [`project_jointly`](super::project_jointly): the impulse each edge of the island passed as
+    /// `islands[i]` carried (mass × length, tension positive), in the island's edge
+    /// order.
+    pub fn edge_impulses(&self, i: usize) -> &[f64] {
+        let (first, count) = self.parts[i].edges;
+        &self.edge_impulse[first as usize..(first + count) as usize]
+    }
+}
