@@ -19,6 +19,7 @@ use crate::export::{ExportError, FrameSettings, Recorder};
 use crate::report::{CrossingReport, IslandReport, Report};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::scenes::ScenesPlugin;
+use crate::scenes::drain::Drain;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
 use crate::snapshot::{RunSnapshot, RunSnapshotError};
 use crate::spawn::spawn_scenario;
@@ -327,6 +328,14 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         notes.push(format!(
             "the spaghetti factory withdrew {withdrawn} lone first particles from its blocked inlet"
         ));
+    }
+    for drain in world.query::<&Drain>().iter(world) {
+        if drain.strands_drained > 0 {
+            notes.push(format!(
+                "the drain took out {} strands ({} particles) to keep {} particles at most",
+                drain.strands_drained, drain.particles_drained, drain.spec.max_particles
+            ));
+        }
     }
     let simulated = world.resource::<SimulationClock>().time - start_time;
     let mut report = report(world, &scene, wall_seconds, particle_steps, simulated);

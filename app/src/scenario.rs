@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::export::raster::View;
+use crate::scenes::drain::DrainSpec;
 use crate::scenes::furry_creature::FurryCreatureSpec;
 use crate::scenes::meatball_factory::MeatballFactorySpec;
 use crate::scenes::spaghetti_factory::SpaghettiFactorySpec;
@@ -95,6 +96,9 @@ pub struct Scenario {
     /// A meatball factory.
     #[serde(default)]
     pub meatball_factory: Option<MeatballFactorySpec>,
+    /// A drain that keeps the pile bounded (for long runs of a factory).
+    #[serde(default)]
+    pub drain: Option<DrainSpec>,
     /// A furry creature.
     #[serde(default)]
     pub furry_creature: Option<FurryCreatureSpec>,
@@ -486,6 +490,11 @@ impl Scenario {
             ] {
                 finite(field, value).map_err(at)?;
             }
+        }
+        if let Some(d) = &self.drain {
+            // A drain keeps at least one strand of the factory's: below that it would
+            // empty the box as fast as it fills.
+            at_least("max_particles", d.max_particles, 2, "a strand").map_err(number("drain"))?;
         }
         if let Some(f) = &self.furry_creature {
             let at = number("furry_creature");

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::scenario::Scenario;
+use crate::scenes::drain::Drain;
 use crate::scenes::furry_creature::FurryCreature;
 use crate::scenes::meatball_factory::{MeatballFactory, MeatballProgress};
 use crate::scenes::spaghetti_factory::{SpaghettiFactory, SpaghettiProgress};
@@ -178,6 +179,10 @@ impl RunSnapshot {
             (self.scenario.meatball_factory, self.meatball_factory)
         {
             world.spawn(MeatballFactory { spec, progress });
+        }
+        if let Some(spec) = self.scenario.drain {
+            // The drain keeps no state: its spec is all it needs.
+            world.spawn(Drain::new(spec));
         }
         if let (Some(spec), Some(record)) = (self.scenario.furry_creature, &self.furry_creature) {
             let roots = record

@@ -7,6 +7,7 @@ use bevy_strands::world::edit::create_edge;
 
 use crate::initial_state::{SceneItems, check_initial_state};
 use crate::scenario::{Scenario, ScenarioError, vec2};
+use crate::scenes::drain::Drain;
 use crate::scenes::furry_creature::spawn_furry_creature;
 use crate::scenes::meatball_factory::MeatballFactory;
 use crate::scenes::spaghetti_factory::SpaghettiFactory;
@@ -88,6 +89,9 @@ pub fn spawn_scenario(world: &mut World, scene: &Scenario) -> Result<(), Scenari
     }
     if let Some(spec) = scene.meatball_factory {
         world.spawn(MeatballFactory::new(spec));
+    }
+    if let Some(spec) = scene.drain {
+        world.spawn(Drain::new(spec));
     }
     if let Some(spec) = scene.furry_creature {
         spawn_furry_creature(world, spec);
