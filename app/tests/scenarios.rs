@@ -163,6 +163,47 @@ fn spaghetti_factory_emits_on_schedule() {
 }
 
 #[test]
+fn a_drain_keeps_the_factory_pile_bounded_exact_and_uncrossed() {
+    // 6 s of extrusion make 120 particles; the drain keeps 40 (walls left out), plus
+    // the strand being extruded, which is held and never leaves.
+    let text = include_str!("../../assets/scenes/spaghetti_factory.ron");
+    let end = text.rfind(')').unwrap();
+    let scene = scratch("drained_factory.ron");
+    let drained = format!("{}    drain: Some((max_particles: 40)),\n)\n", &text[..end]);
+    std::fs::write(&scene, drained).unwrap();
+    let report = run_ok(&RunOptions {
+        scene_file: Some(scene),
+        ..options("", 6.0)
+    });
+    let walls = 4;
+    assert!(
+        report.particles - walls <= 40 + 13,
+        "{} particles",
+        report.particles
+    );
+    let note = report
+        .notes
+        .iter()
+        .find(|n| n.starts_with("the drain took out"))
+        .unwrap_or_else(|| panic!("no drain note: {:?}", report.notes));
+    // Whole strands of 13 leave, the lowest first: about (120 - 40) / 13 of them.
+    let taken: usize = note["the drain took out ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((5..=8).contains(&taken), "{note}");
+    assert!(note.contains(&format!("({} particles)", 13 * taken)), "{note}");
+    assert_eq!(report.edge_crossings, Some(0));
+    assert!(
+        report.max_rel_length_error < 1e-12,
+        "{:e}",
+        report.max_rel_length_error
+    );
+}
+
+#[test]
 fn meatball_factory_drops_spinning_loops() {
     let report = run_ok(&options("meatball_factory", 2.2));
     // Meatballs at 0.5 s and 2.0 s; spaghetti particles at 0, 0.05, …, 2.15 (one due

@@ -336,3 +336,19 @@ fn an_initial_state_that_crosses_overlaps_or_leaves_the_container_is_refused() {
         "{message}"
     );
 }
+
+#[test]
+fn a_drain_that_would_keep_less_than_a_strand_is_refused() {
+    let with_drain = |n: usize| {
+        GOOD.replace(
+            "duration: 1.0,",
+            &format!("duration: 1.0, drain: Some((max_particles: {n})),"),
+        )
+    };
+    let message = rejected(&with_drain(1));
+    assert!(
+        message.contains("drain.max_particles") && message.contains("at least 2"),
+        "{message}"
+    );
+    assert!(Scenario::parse(&with_drain(2), "ok.ron").is_ok());
+}
