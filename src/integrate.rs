@@ -7,11 +7,14 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::forces::implicit_bending::ImplicitBending;
+use crate::forces::quadratic_bending::add_quadratic_bending;
 use crate::model::motion::end_of_step;
 use crate::schedule::{StepSet, StrandsStep};
 use crate::world::clock::SimulationClock;
-use crate::world::config::StrandsConfig;
+use crate::world::config::{BendingModel, StrandsConfig};
 use crate::world::state::ParticleState;
+use crate::world::topology::Topology;
 
 /// `v += dt w f` for every particle.
 pub fn predict_velocities(velocity: &mut [DVec2], force: &[DVec2], inverse_mass: &[f64], dt: f64) {
@@ -32,7 +35,7 @@ pub struct IntegratorPlugin;
 
 impl Plugin for IntegratorPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(
+        app.init_resource::<ImplicitBendingState>().add_systems(
             StrandsStep,
             (
                 predict.in_set(StepSet::Predict),
@@ -42,15 +45,63 @@ impl Plugin for IntegratorPlugin {
     }
 }
 
-/// The Predict stage.
-pub fn predict(config: Res<StrandsConfig>, mut state: ResMut<ParticleState>) {
+/// The quadratic bending model's factored implicit system, and the topology it was
+/// built for.
+#[derive(Resource, Default)]
+pub struct ImplicitBendingState {
+    solver: ImplicitBending,
+    topology_version: Option<u64>,
+    /// Set when the system could not be factored (non-finite masses or stiffness);
+    /// bending is then explicit until the topology changes.
+    failed: bool,
+}
+
+/// The Predict stage: explicit, or with implicit quadratic bending.
+pub fn predict(
+    config: Res<StrandsConfig>,
+    topology: Res<Topology>,
+    mut implicit: ResMut<ImplicitBendingState>,
+    mut state: ResMut<ParticleState>,
+) {
     let ParticleState {
+        position,
         velocity,
         force,
+        mass,
         inverse_mass,
         ..
     } = &mut *state;
-    predict_velocities(velocity, force, inverse_mass, config.dt);
+    if config.bending == BendingModel::Angle || topology.bends.is_empty() {
+        predict_velocities(velocity, force, inverse_mass, config.dt);
+        return;
+    }
+    let implicit = &mut *implicit;
+    let stale = implicit.topology_version != Some(topology.version)
+        || !implicit.solver.is_current(mass, config.dt);
+    if stale {
+        implicit.topology_version = Some(topology.version);
+        implicit.failed = false;
+        if let Err(pivot) = implicit
+            .solver
+            .build(&topology.bends, mass, inverse_mass, config.dt)
+        {
+            error!(
+                "bevy_strands: the implicit bending system is singular at row {} (a \
+                 non-finite mass or stiffness?); bending is explicit until the topology \
+                 changes",
+                pivot.row
+            );
+            implicit.failed = true;
+        }
+    }
+    if implicit.failed {
+        add_quadratic_bending(&topology.bends, position, velocity, force);
+        predict_velocities(velocity, force, inverse_mass, config.dt);
+    } else {
+        implicit
+            .solver
+            .predict(&topology.bends, position, velocity, force, inverse_mass);
+    }
 }
 
 /// The Integrate stage; also advances the simulation clock.

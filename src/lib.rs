@@ -97,7 +97,7 @@ pub mod prelude {
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
-        CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, StrandsConfig,
+        BendingModel, CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, StrandsConfig,
     };
     pub use crate::world::particle::{
         ExternalForce, Frozen, Kinematic, Mass, Particle, Pinned, Position, Tether, Velocity,

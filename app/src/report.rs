@@ -92,6 +92,9 @@ pub struct Report {
     pub max_rel_length_error: f64,
     /// The same over edges with no particle in contact that step.
     pub max_rel_length_error_free: f64,
+    /// The largest particle speed at the end of the run: a bounded motion stays near
+    /// the scene's own speeds, a step past its stability limit grows without bound.
+    pub max_speed_at_end: f64,
     /// Step ends at which two edges sharing no particle intersected; null if unchecked.
     pub edge_crossings: Option<u64>,
     /// The first of those, with its edges; null if none (or unchecked).
@@ -185,6 +188,7 @@ impl Report {
                 "max_rel_length_error_free",
                 format!("{:.3e}", self.max_rel_length_error_free),
             ),
+            ("max_speed_at_end", format!("{:.3e}", self.max_speed_at_end)),
             ("edge_crossings", crossings),
             ("contacts", self.contacts.to_string()),
             ("collisions", self.collisions.to_string()),

@@ -43,6 +43,8 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Constraint solver, instead of the scene's.
     pub solver: Option<String>,
+    /// Bending model, instead of the scene's.
+    pub bending: Option<String>,
     /// Projection iteration cap, instead of the scene's.
     pub iterations: Option<u32>,
     /// Keep stretch springs on constrained edges.
@@ -153,6 +155,9 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
     }
     if let Some(solver) = &options.solver {
         scenario.constraints.solver = solver.parse().map_err(|e| command_line("--solver", e))?;
+    }
+    if let Some(bending) = &options.bending {
+        scenario.step.bending = bending.parse().map_err(|e| command_line("--bending", e))?;
     }
     if let Some(iterations) = options.iterations {
         scenario.constraints.max_iterations = iterations;
@@ -484,6 +489,12 @@ fn report(
         islands: island_report,
         max_rel_length_error: metrics.max_rel_length_error,
         max_rel_length_error_free: metrics.max_rel_length_error_free,
+        max_speed_at_end: world
+            .resource::<ParticleState>()
+            .velocity
+            .iter()
+            .map(|v| v.length())
+            .fold(0.0, f64::max),
         edge_crossings: metrics.edge_crossings,
         first_crossing,
         contacts: metrics.contacts,

@@ -194,12 +194,45 @@ fn a_drain_keeps_the_factory_pile_bounded_exact_and_uncrossed() {
         .parse()
         .unwrap();
     assert!((5..=8).contains(&taken), "{note}");
-    assert!(note.contains(&format!("({} particles)", 13 * taken)), "{note}");
+    assert!(
+        note.contains(&format!("({} particles)", 13 * taken)),
+        "{note}"
+    );
     assert_eq!(report.edge_crossings, Some(0));
     assert!(
         report.max_rel_length_error < 1e-12,
         "{:e}",
         report.max_rel_length_error
+    );
+}
+
+#[test]
+fn the_bending_model_is_chosen_from_the_command_line_and_named_in_the_report() {
+    let quadratic = run_ok(&RunOptions {
+        bending: Some("quadratic".into()),
+        ..options("furry_creature", 0.2)
+    });
+    assert_eq!(quadratic.config["step"]["bending"], "quadratic");
+    assert!(quadratic.max_rel_length_error < 1e-12);
+    let angle = run_ok(&options("furry_creature", 0.2));
+    assert_eq!(angle.config["step"]["bending"], "angle");
+    // The same scene moved by another bending model: close, not the same.
+    assert!((quadratic.max_speed_at_end - angle.max_speed_at_end).abs() < 0.5);
+    assert_ne!(quadratic.max_speed_at_end, angle.max_speed_at_end);
+    let refused = run(
+        &RunOptions {
+            bending: Some("cubic".into()),
+            ..options("long_strand", 0.1)
+        },
+        |_| {},
+    );
+    let message = refused
+        .err()
+        .expect("an unknown model is refused")
+        .to_string();
+    assert!(
+        message.contains("--bending") && message.contains("angle, quadratic"),
+        "{message}"
     );
 }
 

@@ -45,6 +45,7 @@ mod tests {
             rest_angle: 0.0,
             stiffness: 0.7,
             damping: 0.0,
+            rest_lengths: [1.0, 1.0],
         }
     }
 

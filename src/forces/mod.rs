@@ -9,7 +9,9 @@
 pub mod bending;
 pub mod damping;
 pub mod gravity;
+pub mod implicit_bending;
 pub mod plugin;
+pub mod quadratic_bending;
 pub mod springs;
 pub mod tether;
 

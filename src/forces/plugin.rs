@@ -4,7 +4,7 @@ use bevy::prelude::*;
 
 use super::{bending, damping, gravity, springs, tether};
 use crate::schedule::{StepSet, StrandsStep};
-use crate::world::config::StrandsConfig;
+use crate::world::config::{BendingModel, StrandsConfig};
 use crate::world::particle::{SolverIndex, Tether};
 use crate::world::state::ParticleState;
 use crate::world::topology::Topology;
@@ -24,7 +24,7 @@ impl Plugin for ForcesPlugin {
 }
 
 /// Clear the accumulators to the external forces, then add gravity, mass-proportional
-/// damping, stretch springs and bending.
+/// damping, stretch springs and (with the angle model) bending.
 pub fn accumulate_forces(
     config: Res<StrandsConfig>,
     topology: Res<Topology>,
@@ -42,7 +42,10 @@ pub fn accumulate_forces(
     gravity::add_gravity(mass, force, config.gravity);
     damping::add_mass_damping(mass, velocity, force, config.damping);
     springs::add_stretch_springs(&topology.edges, position, velocity, force);
-    bending::add_bending(&topology.bends, position, velocity, force);
+    // The quadratic model is integrated implicitly, in the Predict stage.
+    if config.bending == BendingModel::Angle {
+        bending::add_bending(&topology.bends, position, velocity, force);
+    }
 }
 
 /// Add every tether's force (after the built-in forces).

@@ -72,6 +72,9 @@ pub struct Bend {
     pub stiffness: f64,
     /// Damping of the turning-angle rate.
     pub damping: f64,
+    /// Rest lengths of the edges (a, s) and (s, b): the quadratic bending model's
+    /// unit tangents are the edges over them.
+    pub rest_lengths: [f64; 2],
 }
 
 /// Edges of a strand of `particles` particles: one fewer when open, as many when closed.

@@ -49,6 +49,9 @@ pub struct StrandsConfig {
     pub damping: f64,
     /// Material of strands that carry no [`StrandMaterial`] of their own.
     pub material: StrandMaterial,
+    /// The bending model: the turning-angle model (explicit) or the isometric
+    /// quadratic one (implicit).
+    pub bending: BendingModel,
     /// Whether ticks advance the simulation. A paused simulation keeps its state.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub paused: bool,
@@ -63,6 +66,68 @@ pub struct StrandsConfig {
     /// The most edges the world simulates, likewise.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub max_edges: usize,
+}
+
+/// How bending forces are computed.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(into = "String", try_from = "String")
+)]
+pub enum BendingModel {
+    /// `K (θ − θ̄)²` in the turning angle, integrated explicitly
+    /// ([`crate::forces::bending`]).
+    #[default]
+    Angle,
+    /// `K |d|²` in the bend vector, a quadratic form with a constant Hessian on
+    /// exact-length edges, integrated implicitly
+    /// ([`crate::forces::quadratic_bending`], [`crate::forces::implicit_bending`]).
+    Quadratic,
+}
+
+impl BendingModel {
+    /// Every model.
+    pub const ALL: [BendingModel; 2] = [BendingModel::Angle, BendingModel::Quadratic];
+
+    /// The name used on the command line and in scene files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            BendingModel::Angle => "angle",
+            BendingModel::Quadratic => "quadratic",
+        }
+    }
+}
+
+impl std::fmt::Display for BendingModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for BendingModel {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown bending model '{s}'; valid models: angle, quadratic"))
+    }
+}
+
+impl From<BendingModel> for String {
+    fn from(model: BendingModel) -> String {
+        model.name().to_string()
+    }
+}
+
+impl TryFrom<String> for BendingModel {
+    type Error = String;
+
+    fn try_from(name: String) -> Result<Self, Self::Error> {
+        name.parse()
+    }
 }
 
 /// World units per metre (like avian's `PhysicsLengthUnit`): 1 for a world in metres,
@@ -93,6 +158,7 @@ impl Default for StrandsConfig {
             gravity: DVec2::new(0.0, -9.81),
             damping: 0.0,
             material: StrandMaterial::default(),
+            bending: BendingModel::default(),
             paused: false,
             threads: 0,
             max_particles: DEFAULT_MAX_PARTICLES,

@@ -248,6 +248,7 @@ pub fn rebuild_topology(world: &mut World) {
                 rest_angle: strand.rest_angles.get(j).copied().unwrap_or(0.0),
                 stiffness: material.bending_stiffness / voronoi,
                 damping: material.bending_damping,
+                rest_lengths: [strand.rest_lengths[prev], strand.rest_lengths[s]],
             });
         }
         records.push(StrandRecord {

@@ -55,6 +55,10 @@ struct RunArgs {
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
+    /// Bending model (default: the scene's): `angle` (turning angle, explicit) or
+    /// `quadratic` (isometric quadratic, implicit).
+    #[arg(long, value_name = "MODEL")]
+    bending: Option<String>,
     /// Cap on constraint-projection iterations (relaxation sweeps for the baselines) per
     /// island per step (default: the scene's, 20).
     #[arg(long, value_name = "N")]
@@ -155,6 +159,7 @@ fn main() -> ExitCode {
                 substeps: args.substeps,
                 threads: args.threads,
                 solver: args.solver,
+                bending: args.bending,
                 iterations: args.iterations,
                 stretch_springs: args.stretch_springs,
                 start_of_step: args.start_of_step,
