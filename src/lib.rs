@@ -71,7 +71,7 @@ use metrics::MetricsPlugin;
 use schedule::{SchedulePlugin, StrandsTick, TickSet};
 use world::clock::SimulationClock;
 use world::config::{CollisionConfig, LengthUnit, StrandsConfig};
-use world::hooks::TopologyDirty;
+use world::hooks::{SpawnOrder, TopologyDirty};
 use world::problems::InputProblems;
 use world::state::ParticleState;
 use world::sync::{gather, write_back};
@@ -203,6 +203,7 @@ impl Plugin for StrandsCorePlugin {
             .init_resource::<ParticleState>()
             .init_resource::<Topology>()
             .init_resource::<TopologyDirty>()
+            .init_resource::<SpawnOrder>()
             .init_resource::<InputProblems>()
             .init_resource::<SimulationClock>()
             .register_type::<StrandsConfig>()

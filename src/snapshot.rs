@@ -4,9 +4,11 @@
 //!
 //! Particles are numbered by their position in [`StrandsSnapshot::particles`]; strands
 //! refer to them by that number. Both lists are kept in the order the topology rebuild
-//! sorts entities in, and [`StrandsSnapshot::restore`] spawns them so that the new
-//! entities sort the same way: the packed order, and with it every sum of a step, is
-//! then the same as in the world captured, and a restored run continues bit for bit.
+//! sorts them in (their [`SpawnOrder`], newest first), and [`StrandsSnapshot::restore`]
+//! spawns them so that the new ones sort the same way: the packed order, and with it
+//! every sum of a step, is then the same as in the world captured, and a restored run
+//! continues bit for bit — also after despawns, whose freed entity slots the captured
+//! world reuses and the restored one does not have.
 
 use bevy::ecs::entity::EntityHashMap;
 use bevy::math::DVec2;
@@ -14,6 +16,7 @@ use bevy::prelude::*;
 
 use crate::schedule::synchronise;
 use crate::world::clock::SimulationClock;
+use crate::world::hooks::SpawnOrder;
 use crate::world::particle::{
     ExternalForce, Kinematic, Mass, Particle, Pinned, Position, Velocity,
 };
@@ -150,10 +153,15 @@ impl StrandsSnapshot {
     pub fn capture(world: &mut World) -> (StrandsSnapshot, SnapshotEntities) {
         let mut strand_query = world.query_filtered::<Entity, With<Strand>>();
         let mut strands: Vec<Entity> = strand_query.iter(world).collect();
-        strands.sort();
         let mut particle_query = world.query_filtered::<Entity, With<Particle>>();
         let mut particles: Vec<Entity> = particle_query.iter(world).collect();
-        particles.sort();
+        if let Some(order) = world.get_resource::<SpawnOrder>() {
+            strands.sort_by_key(|&e| order.strand_key(e));
+            particles.sort_by_key(|&e| order.particle_key(e));
+        } else {
+            strands.sort();
+            particles.sort();
+        }
         let entities = SnapshotEntities { particles, strands };
         let number: EntityHashMap<u32> = entities
             .particles
@@ -246,8 +254,9 @@ impl StrandsSnapshot {
         if count > 0 {
             return Err(SnapshotError::NotEmpty(count));
         }
-        // A fresh world hands out entity indices in increasing order, and entities sort
-        // with later indices first: spawn in reverse to keep the captured order.
+        // Spawned in reverse, the last captured first, they are numbered in reverse, and
+        // sort newest first in the captured order (as fresh entities also do by their
+        // own `Ord`, for a world without `SpawnOrder`).
         let mut strands = vec![Entity::PLACEHOLDER; self.strands.len()];
         for (slot, record) in strands.iter_mut().zip(&self.strands).rev() {
             let mut entity = world.spawn(record.kind);
@@ -279,7 +288,9 @@ impl StrandsSnapshot {
             }
             *slot = entity.id();
         }
-        for (&entity, record) in strands.iter().zip(&self.strands) {
+        // Strands are numbered in the order their `Strand` arrives, newest first in
+        // the topology: insert the last captured first.
+        for (&entity, record) in strands.iter().zip(&self.strands).rev() {
             world.entity_mut(entity).insert(Strand {
                 particles: record
                     .particles
@@ -296,7 +307,16 @@ impl StrandsSnapshot {
         // state as the last tick left them: build them now, as that tick would have.
         synchronise(world);
         let restored = SnapshotEntities { particles, strands };
-        if !(restored.particles.is_sorted() && restored.strands.is_sorted()) {
+        let in_order = match world.get_resource::<SpawnOrder>() {
+            Some(order) => {
+                restored
+                    .particles
+                    .is_sorted_by_key(|&e| order.particle_key(e))
+                    && restored.strands.is_sorted_by_key(|&e| order.strand_key(e))
+            }
+            None => restored.particles.is_sorted() && restored.strands.is_sorted(),
+        };
+        if !in_order {
             warn!(
                 "bevy_strands: the restored entities do not sort as the captured ones did; \
                  the run continues, but not bit for bit"

@@ -226,10 +226,10 @@ fn the_bending_model_is_chosen_from_the_command_line_and_named_in_the_report() {
         },
         |_| {},
     );
-    let message = refused
-        .err()
-        .expect("an unknown model is refused")
-        .to_string();
+    let Err(error) = refused else {
+        panic!("an unknown bending model was accepted");
+    };
+    let message = error.to_string();
     assert!(
         message.contains("--bending") && message.contains("angle, quadratic"),
         "{message}"

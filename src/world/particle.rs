@@ -6,7 +6,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use crate::world::hooks::on_structure_changed;
+use crate::world::hooks::{on_particle_added, on_particle_removed, on_structure_changed};
 
 /// Marks an entity as a simulated particle and brings in the components it needs.
 ///
@@ -20,7 +20,7 @@ use crate::world::hooks::on_structure_changed;
 #[derive(Component, Reflect, Clone, Copy, Debug, Default)]
 #[reflect(Component)]
 #[require(Position, Velocity, Mass, SolverIndex)]
-#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+#[component(on_add = on_particle_added, on_remove = on_particle_removed)]
 pub struct Particle;
 
 /// Position in world units (the canonical scenes use the unit box).

@@ -11,7 +11,7 @@ use bevy::prelude::*;
 
 use crate::model::validate::{NumberError, non_negative};
 use crate::model::{bend_count, edge_count};
-use crate::world::hooks::on_structure_changed;
+use crate::world::hooks::{on_strand_inserted, on_strand_removed};
 
 /// The connectivity of a strand: its particles in order, the rest length of each edge,
 /// the rest turning angle at each bending vertex, and whether the last particle joins
@@ -22,7 +22,7 @@ use crate::world::hooks::on_structure_changed;
 /// is `particles[k + 1]`; of a closed strand, `particles[k]`.
 #[derive(Component, Reflect, Clone, Debug, Default, PartialEq)]
 #[reflect(Component)]
-#[component(on_insert = on_structure_changed, on_remove = on_structure_changed)]
+#[component(on_insert = on_strand_inserted, on_remove = on_strand_removed)]
 pub struct Strand {
     /// Particles in order along the strand.
     pub particles: Vec<Entity>,

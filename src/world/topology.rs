@@ -16,7 +16,7 @@ use bevy::prelude::*;
 use crate::model::validate::{StrandError, check_particle, check_strand_shape};
 use crate::model::{Bend, Edge, NO_ISLAND, bend_count};
 use crate::world::config::StrandsConfig;
-use crate::world::hooks::TopologyDirty;
+use crate::world::hooks::{SpawnOrder, TopologyDirty};
 use crate::world::particle::{
     Frozen, Kinematic, Mass, Particle, Pinned, Position, SolverIndex, Velocity,
 };
@@ -141,7 +141,9 @@ pub fn rebuild_topology(world: &mut World) {
             },
         )
         .collect();
-    strands.sort_by_key(|(entity, ..)| *entity);
+    let no_order = SpawnOrder::default();
+    let spawn_order = world.get_resource::<SpawnOrder>().unwrap_or(&no_order);
+    strands.sort_by_key(|(entity, ..)| spawn_order.strand_key(*entity));
 
     // Packed order: strand by strand along each strand, then loose particles; a strand
     // or particle past the caps is left out, its particles with it.
@@ -186,7 +188,7 @@ pub fn rebuild_topology(world: &mut World) {
         .copied()
         .filter(|p| !index.contains_key(p) && !left_out.contains_key(p))
         .collect();
-    loose.sort();
+    loose.sort_by_key(|p| spawn_order.particle_key(*p));
     let room = max_particles - order.len();
     if let Some(&first) = loose.get(room) {
         problems.report(
