@@ -456,6 +456,17 @@ fn report(
     if metrics.edge_crossings.is_none() {
         notes.push("edge crossings were not checked (--no-check)".to_string());
     }
+    // Exact and uncrossed, but not by the contact physics: say so when it is common.
+    let steps = world.resource::<SimulationClock>().steps;
+    if metrics.failsafe_steps > 0 && metrics.failsafe_steps * 10 >= steps {
+        notes.push(format!(
+            "{} of {steps} steps ended in the collision fail-safe: impact zones moved \
+             rigidly, which keeps every edge and every side but stops or turns whole \
+             strands instead of resolving the contacts; the step is too large for the \
+             motion, or the forces too large for the step",
+            metrics.failsafe_steps
+        ));
+    }
     if let Some(last) = &metrics.last_unresolved {
         notes.push(format!(
             "{} collisions were left unresolved by the fail-safe (kinematic particles driven into each other); the latest at step {}: point {} against the edge {}–{}{}",

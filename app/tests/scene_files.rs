@@ -247,6 +247,37 @@ fn a_state_gone_non_finite_stops_the_run_with_an_error() {
 }
 
 #[test]
+fn a_gravity_no_step_can_resolve_ends_in_the_fail_safe_and_says_so() {
+    // long_strand under a gravity of 1e308 (its particles weigh 1 kg: the forces stay
+    // finite): the impulses cannot stop the strand at the floor, the rigid impact
+    // zones do, every step. Exact and uncrossed, but not physics: the report says so.
+    let scene = include_str!("../../assets/scenes/long_strand.ron")
+        .replace("gravity: (0.0, -9.81)", "gravity: (0.0, -1e308)");
+    let dir = std::env::temp_dir().join(format!("bevy_strands_failsafe_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("heavy.ron");
+    std::fs::write(&file, scene).unwrap();
+    let options = RunOptions {
+        scene_file: Some(file),
+        seconds: Some(0.3),
+        check_crossings: true,
+        ..Default::default()
+    };
+    let report = bevy_strands_app::runner::run(&options, |_| {}).unwrap();
+    assert_eq!(report.edge_crossings, Some(0));
+    assert!(report.max_rel_length_error < 1e-9);
+    assert_eq!(report.failsafe_steps, report.steps);
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("90 of 90 steps ended in the collision fail-safe")),
+        "{:?}",
+        report.notes
+    );
+}
+
+#[test]
 fn a_scene_larger_than_its_particle_cap_is_refused_before_anything_is_allocated() {
     let message = rejected(&GOOD.replace("particles: 10,", "particles: 1000000000,"));
     assert!(
