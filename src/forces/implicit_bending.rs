@@ -36,6 +36,10 @@ pub struct ImplicitBending {
     /// The masses and the step the factor holds.
     masses: Vec<f64>,
     dt: f64,
+    /// Each bend's matrices `C_a, C_s, C_b` (a rotation by the rest angle: computed
+    /// once, not every step) and its weight `h c + 2 h² k`.
+    matrices: Vec<[DMat2; 3]>,
+    weights: Vec<f64>,
     plan: SparsePlan,
     factor: SparseFactor,
     /// Right-hand side, in elimination order.
@@ -85,11 +89,19 @@ impl ImplicitBending {
         self.masses
             .extend(self.particles.iter().map(|&p| mass[p as usize]));
         self.dt = dt;
+        self.matrices.clear();
+        self.matrices.extend(bends.iter().map(bend_matrices));
+        self.weights.clear();
+        self.weights.extend(
+            bends
+                .iter()
+                .map(|b| dt * b.damping + 2.0 * dt * dt * b.stiffness),
+        );
 
         // Every block, and every coupled pair of coordinates in them (a zero entry is
         // left out, so that a straight rest shape keeps x and y apart).
         let mut blocks = Vec::new();
-        self.for_each_block(bends, dt, |entry| blocks.push(entry));
+        self.for_each_block(bends, |entry| blocks.push(entry));
         let entries = |&(u, v, block): &(u32, u32, DMat2)| {
             [(0, 0), (0, 1), (1, 0), (1, 1)]
                 .into_iter()
@@ -134,17 +146,15 @@ impl ImplicitBending {
     }
 
     /// Every block `(h c + 2 h² k) C_iᵀ C_j` between unknown particles of a bend.
-    fn for_each_block(&self, bends: &[Bend], dt: f64, mut visit: impl FnMut((u32, u32, DMat2))) {
-        for bend in bends {
-            let matrices = bend_matrices(bend);
-            let weight = dt * bend.damping + 2.0 * dt * dt * bend.stiffness;
+    fn for_each_block(&self, bends: &[Bend], mut visit: impl FnMut((u32, u32, DMat2))) {
+        for ((bend, matrices), &weight) in bends.iter().zip(&self.matrices).zip(&self.weights) {
             let ends = [bend.a, bend.s, bend.b];
-            for (i, ci) in ends.iter().zip(&matrices) {
+            for (i, ci) in ends.iter().zip(matrices) {
                 let u = self.unknown_of[*i as usize];
                 if u == NONE {
                     continue;
                 }
-                for (j, cj) in ends.iter().zip(&matrices) {
+                for (j, cj) in ends.iter().zip(matrices) {
                     let v = self.unknown_of[*j as usize];
                     if v != NONE {
                         visit((u, v, ci.transpose() * *cj * weight));
@@ -155,7 +165,8 @@ impl ImplicitBending {
     }
 
     /// The predictor with implicit bending: `velocity` from the step's start to its
-    /// candidate, `force` holding every force but bending.
+    /// candidate, `force` holding every force but bending. `bends` are those the
+    /// system was built for.
     pub fn predict(
         &mut self,
         bends: &[Bend],
@@ -178,19 +189,18 @@ impl ImplicitBending {
             }
         }
         // − h K x, and the pinned particles' prescribed velocities moved to the right.
-        for bend in bends {
-            let matrices = bend_matrices(bend);
+        debug_assert_eq!(bends.len(), self.matrices.len(), "built for other bends");
+        for ((bend, matrices), &weight) in bends.iter().zip(&self.matrices).zip(&self.weights) {
             let ends = [bend.a, bend.s, bend.b];
-            let d = bend_vector(bend, &matrices, position);
-            let weight = dt * bend.damping + 2.0 * dt * dt * bend.stiffness;
+            let d = bend_vector(bend, matrices, position);
             let mut pinned_rate = DVec2::ZERO;
-            for (&j, c) in ends.iter().zip(&matrices) {
+            for (&j, c) in ends.iter().zip(matrices) {
                 if self.unknown_of[j as usize] == NONE {
                     pinned_rate += *c * velocity[j as usize];
                 }
             }
             let pull = -2.0 * dt * bend.stiffness * d - weight * pinned_rate;
-            for (&i, c) in ends.iter().zip(&matrices) {
+            for (&i, c) in ends.iter().zip(matrices) {
                 let u = self.unknown_of[i as usize];
                 if u != NONE {
                     let add = c.transpose() * pull;

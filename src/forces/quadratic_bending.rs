@@ -14,8 +14,8 @@
 //! `K |d|²` is therefore the angle model's `K (θ − θ̄)²` on exact-length
 //! configurations, up to that approximation, and it is a quadratic form in the
 //! positions with the constant Hessian `2K Jᵀ J`: forces are a sparse matrix–vector
-//! product, and an implicit step needs one factorization per topology change
-//! ([`super::implicit_bending`]). Damping `c |ḋ|² / 2` gives the constant matrix `c JᵀJ`.
+//! product, and an implicit step needs one factorization per topology change (the
+//! `implicit_bending` module). Damping `c |ḋ|² / 2` gives the constant matrix `c JᵀJ`.
 
 use bevy::math::{DMat2, DVec2};
 
@@ -47,7 +47,7 @@ pub fn quadratic_bending_energy(bends: &[Bend], position: &[DVec2]) -> f64 {
 }
 
 /// Add every element's force, `f_j = −C_jᵀ (2K d + c ḋ)` (explicitly: the implicit
-/// step in [`super::implicit_bending`] is how the simulation uses the model).
+/// step of the `implicit_bending` module is how the simulation uses the model).
 pub fn add_quadratic_bending(
     bends: &[Bend],
     position: &[DVec2],
