@@ -156,8 +156,8 @@ impl StrandsSnapshot {
         let mut particle_query = world.query_filtered::<Entity, With<Particle>>();
         let mut particles: Vec<Entity> = particle_query.iter(world).collect();
         if let Some(order) = world.get_resource::<SpawnOrder>() {
-            strands.sort_by_key(|&e| order.strand_key(e));
-            particles.sort_by_key(|&e| order.particle_key(e));
+            strands.sort_by_cached_key(|&e| order.strand_key(e));
+            particles.sort_by_cached_key(|&e| order.particle_key(e));
         } else {
             strands.sort();
             particles.sort();

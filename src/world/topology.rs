@@ -143,7 +143,7 @@ pub fn rebuild_topology(world: &mut World) {
         .collect();
     let no_order = SpawnOrder::default();
     let spawn_order = world.get_resource::<SpawnOrder>().unwrap_or(&no_order);
-    strands.sort_by_key(|(entity, ..)| spawn_order.strand_key(*entity));
+    strands.sort_by_cached_key(|(entity, ..)| spawn_order.strand_key(*entity));
 
     // Packed order: strand by strand along each strand, then loose particles; a strand
     // or particle past the caps is left out, its particles with it.
@@ -188,7 +188,7 @@ pub fn rebuild_topology(world: &mut World) {
         .copied()
         .filter(|p| !index.contains_key(p) && !left_out.contains_key(p))
         .collect();
-    loose.sort_by_key(|p| spawn_order.particle_key(*p));
+    loose.sort_by_cached_key(|p| spawn_order.particle_key(*p));
     let room = max_particles - order.len();
     if let Some(&first) = loose.get(room) {
         problems.report(
