@@ -28,6 +28,15 @@ fn rejected(text: &str) -> String {
     }
 }
 
+/// `text` written to a file of this test process's own.
+fn scene_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("bevy_strands_scenes_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
 #[test]
 fn builtin_scenes_are_valid() {
     for scene in BUILTIN_SCENES {
@@ -228,12 +237,8 @@ fn a_state_gone_non_finite_stops_the_run_with_an_error() {
     let scene = GOOD
         .replace("duration: 1.0", "duration: 4e300")
         .replace("dt: 0.001, substeps: 10", "dt: 1e300, substeps: 1");
-    let dir = std::env::temp_dir().join(format!("bevy_strands_nonfinite_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("huge_step.ron");
-    std::fs::write(&file, scene).unwrap();
     let options = RunOptions {
-        scene_file: Some(file),
+        scene_file: Some(scene_file("huge_step.ron", &scene)),
         check_crossings: true,
         ..Default::default()
     };
@@ -253,12 +258,8 @@ fn a_gravity_no_step_can_resolve_ends_in_the_fail_safe_and_says_so() {
     // zones do, every step. Exact and uncrossed, but not physics: the report says so.
     let scene = include_str!("../../assets/scenes/long_strand.ron")
         .replace("gravity: (0.0, -9.81)", "gravity: (0.0, -1e308)");
-    let dir = std::env::temp_dir().join(format!("bevy_strands_failsafe_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("heavy.ron");
-    std::fs::write(&file, scene).unwrap();
     let options = RunOptions {
-        scene_file: Some(file),
+        scene_file: Some(scene_file("heavy.ron", &scene)),
         seconds: Some(0.3),
         check_crossings: true,
         ..Default::default()
