@@ -5,16 +5,33 @@
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::sync::Once;
 
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
-use super::{ExportError, io_error, text::FONT};
+use super::{ExportError, io_error};
 use bevy_strands::metrics::ErrorSample;
 
 /// Errors below this are drawn at it (a log scale has no zero).
 pub const PLOT_FLOOR: f64 = 1e-17;
+
+/// plotters draws text only in fonts registered with it, once per process.
+#[cfg(not(target_arch = "wasm32"))]
+fn register_font() -> Result<(), String> {
+    use plotters::style::FontStyle;
+    use std::sync::Once;
+    static FONT_REGISTERED: Once = Once::new();
+    FONT_REGISTERED.call_once(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, super::text::FONT)
+            .unwrap_or_else(|_| panic!("the embedded font parses"));
+    });
+    Ok(())
+}
+
+/// plotters has no font registry on wasm32 (and a web page has no files to write).
+#[cfg(target_arch = "wasm32")]
+fn register_font() -> Result<(), String> {
+    Err("plots cannot be drawn on wasm32: plotters has no font registry there".into())
+}
 
 /// Draw the history into a PNG file of `width × height` pixels.
 pub fn plot_length_error(
@@ -23,15 +40,11 @@ pub fn plot_length_error(
     samples: &[ErrorSample],
     (width, height): (u32, u32),
 ) -> Result<(), ExportError> {
-    static FONT_REGISTERED: Once = Once::new();
-    FONT_REGISTERED.call_once(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-            .unwrap_or_else(|_| panic!("the embedded font parses"));
-    });
     let fail = |message: String| ExportError::Plot {
         path: path.to_path_buf(),
         message,
     };
+    register_font().map_err(fail)?;
     // The largest error in each time bucket, two pixel columns wide: thousands of
     // zigzagging points per column draw as noise, and plotters' bitmap rasterizer
     // draws exactly vertical segments (two points in one column) with false spikes.
