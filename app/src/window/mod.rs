@@ -16,6 +16,8 @@
 //! ```
 
 mod layout;
+mod pace;
+pub mod page;
 mod screenshot;
 mod tools;
 mod ui;
@@ -32,17 +34,21 @@ use crate::scenes::ScenesPlugin;
 use crate::spawn::spawn_scenario;
 
 pub use layout::UiLayout;
+pub use pace::{PacePlugin, RealTimeFactor};
 pub use screenshot::ScreenshotPlugin;
 pub use tools::{Tool, ToolState};
 pub use ui::{StrandsUiPlugin, UiKeys};
 pub use view::DemoViewPlugin;
 
-/// Bevy's default plugins for an example window: 1280×720, titled.
+/// Bevy's default plugins for an example window: 1280×720, titled. On the web the
+/// window is the page's `<canvas id="strands">`, sized to its parent.
 pub fn window_plugins(title: &str) -> PluginGroupBuilder {
     DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
             title: format!("bevy_strands: {title}"),
             resolution: WindowResolution::new(1280, 720),
+            canvas: cfg!(target_arch = "wasm32").then(|| "#strands".to_string()),
+            fit_canvas_to_parent: cfg!(target_arch = "wasm32"),
             ..default()
         }),
         ..default()
@@ -60,6 +66,7 @@ impl PluginGroup for DemoPlugins {
             .add(StrandsDebugDrawPlugin)
             .add(DemoViewPlugin)
             .add(StrandsUiPlugin)
+            .add(PacePlugin)
     }
 }
 
@@ -86,6 +93,35 @@ impl ActiveScenario {
         Ok(Self {
             scenario: scene.scenario()?,
         })
+    }
+}
+
+/// The scenarios the panel offers to switch between (none when absent).
+#[derive(Resource, Clone, Debug, Default)]
+pub struct ScenarioMenu {
+    /// Built-in scenario names, in the menu's order.
+    pub names: Vec<String>,
+    /// Whether the scenarios it starts check for crossed edges every step.
+    pub check_crossings: bool,
+}
+
+impl ScenarioMenu {
+    /// A menu of built-in scenarios; an unknown name is refused with the valid ones.
+    pub fn builtin(names: &[&str]) -> Result<Self, ScenarioError> {
+        for name in names {
+            ActiveScenario::builtin(name)?;
+        }
+        Ok(Self {
+            names: names.iter().map(|n| n.to_string()).collect(),
+            check_crossings: false,
+        })
+    }
+
+    /// The built-in scenario `name` as this menu starts it.
+    pub fn scenario(&self, name: &str) -> Result<ActiveScenario, ScenarioError> {
+        let mut active = ActiveScenario::builtin(name)?;
+        active.scenario.collisions.check_crossings |= self.check_crossings;
+        Ok(active)
     }
 }
 

@@ -64,6 +64,8 @@ pub struct ToolState {
     pub hovered: Option<Entity>,
     /// Its position.
     pub hovered_position: Option<DVec2>,
+    /// The cursor's world position, when it is over the window.
+    pub cursor: Option<DVec2>,
     /// Spacing of drawn hairs.
     pub hair_spacing: f64,
     /// The last tool error, shown in the panel.
@@ -78,11 +80,19 @@ impl Default for ToolState {
             tool: Tool::Drag,
             hovered: None,
             hovered_position: None,
+            cursor: None,
             hair_spacing: 0.015,
             message: None,
             dragging: None,
             stroke: Vec::new(),
         }
+    }
+}
+
+impl ToolState {
+    /// The particle a drag holds, if one is in progress.
+    pub fn dragging(&self) -> Option<Entity> {
+        self.dragging
     }
 }
 
@@ -124,8 +134,10 @@ pub fn use_tools(
     let Some((screen, cursor, pixel)) = cursor_in_world(&windows, &cameras) else {
         tools.hovered = None;
         tools.hovered_position = None;
+        tools.cursor = None;
         return;
     };
+    tools.cursor = Some(cursor);
     let pick = 12.0 * pixel;
     let nearest = state
         .position

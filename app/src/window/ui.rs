@@ -16,9 +16,10 @@ use bevy_strands::render::DrawSettings;
 use bevy_strands::world::clock::StepTiming;
 
 use super::layout::UiLayout;
+use super::pace::RealTimeFactor;
 use super::screenshot::ScreenshotPlugin;
 use super::tools::{Tool, ToolState, use_tools};
-use super::{ActiveScenario, spawn_active_scenario};
+use super::{ActiveScenario, ScenarioMenu, spawn_active_scenario};
 use crate::export::{FrameSettings, Recorder};
 use crate::scenes::furry_creature::FurryCreature;
 use crate::scenes::meatball_factory::MeatballFactory;
@@ -134,8 +135,10 @@ struct Figures<'w> {
     clock: Res<'w, SimulationClock>,
     history: Res<'w, LengthErrorHistory>,
     timing: Res<'w, StepTiming>,
+    rate: Option<Res<'w, RealTimeFactor>>,
     problems: Res<'w, InputProblems>,
     active: Option<Res<'w, ActiveScenario>>,
+    menu: Option<Res<'w, ScenarioMenu>>,
     export: Res<'w, FrameExport>,
 }
 
@@ -175,6 +178,9 @@ fn panel(
         .vscroll(true)
         .max_height(height)
         .show(ctx, |ui| {
+            if let (Some(menu), Some(active)) = (&figures.menu, &figures.active) {
+                scenario_menu(ui, menu, &active.scenario.name, &mut commands);
+            }
             controls(ui, &mut settings, &mut commands);
             ui.separator();
             figures_ui(ui, &figures, &settings);
@@ -195,6 +201,28 @@ fn panel(
     layout.pointer_busy = ctx.egui_is_using_pointer();
     layout.keyboard_over_ui = ctx.egui_wants_keyboard_input();
     Ok(())
+}
+
+/// Switch to another scenario: it replaces the active one and the scene restarts.
+fn scenario_menu(ui: &mut egui::Ui, menu: &ScenarioMenu, current: &str, commands: &mut Commands) {
+    let mut chosen = current.to_string();
+    egui::ComboBox::from_label("scene")
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            for name in &menu.names {
+                ui.selectable_value(&mut chosen, name.clone(), name);
+            }
+        });
+    if chosen != current {
+        let menu = menu.clone();
+        commands.queue(move |world: &mut World| match menu.scenario(&chosen) {
+            Ok(active) => {
+                world.insert_resource(active);
+                reset(world);
+            }
+            Err(e) => error!("bevy_strands: {e}"),
+        });
+    }
 }
 
 fn controls(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands) {
@@ -276,6 +304,11 @@ fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
         row("impulses / step", format!("{}", m.collisions_last_step));
         row("fail-safe steps", format!("{}", m.failsafe_steps));
         row("ms / step", format!("{per_step_ms:.3}"));
+        row(
+            "real-time factor",
+            (figures.rate.as_ref().and_then(|r| r.value))
+                .map_or("measuring".into(), |r| format!("{r:.2}")),
+        );
     });
     // The length error over time, log scale.
     let points: PlotPoints = figures
