@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The web demo: the `web` example built for wasm32-unknown-unknown (WebGL2, one
+# thread), bound to JavaScript by wasm-bindgen and written with its page into a static
+# folder that any web server serves. Installs what a fresh machine lacks: the wasm32
+# target (rustup) and wasm-bindgen-cli at the version Cargo.lock pins (from crates.io,
+# built here).
+#
+# Usage: scripts/web.sh [output folder, default target/web-demo]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-target/web-demo}
+
+rustup target list --installed | grep -qx wasm32-unknown-unknown \
+    || rustup target add wasm32-unknown-unknown
+# The command-line tool must be the same version as the wasm-bindgen crate linked in.
+version=$(awk '$0 == "name = \"wasm-bindgen\"" { getline; gsub(/"/, "", $3); print $3; exit }' Cargo.lock)
+if [ "$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }')" != "$version" ]; then
+    # Its own lock file pins crates a registry may no longer offer (a yanked
+    # webpki-roots, seen here): then resolve afresh within its version requirements.
+    cargo install wasm-bindgen-cli --version "$version" --locked \
+        || cargo install wasm-bindgen-cli --version "$version"
+fi
+
+cargo build --profile web --target wasm32-unknown-unknown -p bevy_strands_app \
+    --features web --example web
+mkdir -p "$out"
+wasm-bindgen --target web --no-typescript --remove-name-section --remove-producers-section --out-dir "$out" --out-name strands \
+    target/wasm32-unknown-unknown/web/examples/web.wasm
+cp app/web/index.html "$out/"
+echo "the web demo is in $out: serve it, e.g. python3 -m http.server -d $out 8080,"
+echo "and open http://localhost:8080 (?scene=meatball_factory or ?scene=long_strand)"
