@@ -508,6 +508,19 @@ impl Scenario {
                 positive(field, value).map_err(at)?;
             }
             non_negative("path_radius", f.path_radius).map_err(at)?;
+            if let Some(inset) = f.body_inset {
+                positive("body_inset", inset).map_err(at)?;
+                if inset >= f.body_radius {
+                    return Err(ScenarioError::new(
+                        file,
+                        "furry_creature.body_inset",
+                        format!(
+                            "{inset} leaves no body inside the rim (body_radius {})",
+                            f.body_radius
+                        ),
+                    ));
+                }
+            }
             at_least(
                 "particles_per_hair",
                 f.particles_per_hair,

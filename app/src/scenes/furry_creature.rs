@@ -32,7 +32,15 @@ pub struct FurryCreatureSpec {
     /// Mass of each particle.
     #[serde(default = "one")]
     pub mass: f64,
+    /// Hairs collide with the body when set: its collision outline, a driven wall
+    /// polygon around the centre, stands this far inside the rim, so the roots (which
+    /// cannot move off the rim) never touch it. Unset, hairs pass over the body.
+    #[serde(default)]
+    pub body_inset: Option<f64>,
 }
+
+/// Largest gap between the body's collision polygon and its circle.
+const OUTLINE_TOLERANCE: f64 = 1e-4;
 
 fn one() -> f64 {
     1.0
@@ -112,9 +120,45 @@ pub fn spawn_furry_creature(world: &mut World, spec: FurryCreatureSpec) -> Entit
             ));
         }
     }
+    if let Some(inset) = spec.body_inset {
+        match spawn_body_outline(world, &spec, spec.body_radius - inset) {
+            Ok(outline) => roots.extend(outline),
+            Err(e) => error!("furry creature: the body's outline was refused: {e}"),
+        }
+    }
     let creature = FurryCreature::new(spec, roots);
     let disc = creature.disc(0.0);
     world.spawn((creature, disc)).id()
+}
+
+/// The body's collision outline: a pinned wall polygon circumscribing the circle of
+/// `radius` about the body's centre (within [`OUTLINE_TOLERANCE`]), driven like the
+/// roots. Returns its particles and their offsets from the centre.
+fn spawn_body_outline(
+    world: &mut World,
+    spec: &FurryCreatureSpec,
+    radius: f64,
+) -> Result<Vec<(Entity, DVec2)>, String> {
+    if !radius.is_finite() || radius <= 0.0 {
+        return Err(format!("body_inset leaves a radius of {radius}"));
+    }
+    // A side spanning θ stands r (1 / cos(θ/2) − 1) off the circle at its corners.
+    let per_side = 2.0 * (radius / (radius + OUTLINE_TOLERANCE)).acos();
+    let sides = ((TAU / per_side).ceil() as usize).max(3);
+    let corner = radius / (0.5 * TAU / sides as f64).cos();
+    let offsets: Vec<DVec2> = (0..sides)
+        .map(|k| corner * DVec2::from_angle(TAU * k as f64 / sides as f64))
+        .collect();
+    let start = spec.body_centre(0.0);
+    let mut builder = StrandBuilder::closed_loop(offsets.iter().map(|&o| start + o))
+        .kind(StrandKind::Wall)
+        .material(StrandMaterial::INERT);
+    for k in 0..sides {
+        builder = builder.pin(k);
+    }
+    let strand = builder.spawn_in(world).map_err(|e| e.to_string())?;
+    let particles = &world.get::<Strand>(strand).expect("just spawned").particles;
+    Ok(particles.iter().copied().zip(offsets).collect())
 }
 
 /// Give every root the velocity that lands it on the body's path at the end of the
