@@ -178,6 +178,7 @@ pub fn speculate(
         &settings,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
+        collider.settings.threads,
     );
     // Remember the impulses for the next step's rows of the same pairs, and the
     // contacts that took one.
@@ -345,6 +346,7 @@ fn reproject(
         settings,
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
+        collider.settings.threads,
     );
     for &(island, met) in &buffers.outcomes {
         collider.scratch.projected(island, met);

@@ -79,3 +79,35 @@ fn a_rerun_gives_the_same_report_bit_for_bit() {
         assert!(first.contacts > 0, "{scenario} reached contact");
     }
 }
+
+#[test]
+fn the_joint_groups_shared_between_threads_give_the_same_report() {
+    // The dense pile: thousands of contact rows a step in many independent groups,
+    // projected on two lanes with two threads.
+    let options = |threads| RunOptions {
+        scenario: "pile".into(),
+        seconds: Some(0.3),
+        threads: Some(threads),
+        check_crossings: true,
+        ..Default::default()
+    };
+    let one = run(&options(1), |_| {}).unwrap();
+    let two = run(&options(2), |_| {}).unwrap();
+    assert_eq!((one.threads, two.threads), (1, 2));
+    assert_eq!(figures(&one), figures(&two));
+    // More joint projections than steps: the steps' rows fell into several groups.
+    assert!(
+        one.contact_projection_solves > 2 * one.steps,
+        "{} joint projections in {} steps",
+        one.contact_projection_solves,
+        one.steps
+    );
+    // Enough rows a step (on average) for the lanes to be used.
+    assert!(one.contacts > 512 * one.steps, "{} contacts", one.contacts);
+    assert_eq!(one.edge_crossings, Some(0));
+    assert!(
+        one.max_rel_length_error < 1e-12,
+        "{:e}",
+        one.max_rel_length_error
+    );
+}

@@ -12,6 +12,7 @@ pub mod cyclic;
 pub mod graph;
 pub mod island_edge;
 pub mod islands;
+pub mod joint_groups;
 pub mod plugin;
 pub mod projection;
 pub mod relaxation;

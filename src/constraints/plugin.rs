@@ -4,11 +4,12 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+mod joint_driver;
+
 use super::islands::{IslandKind, IslandSet, find_islands};
 use super::projection::{
-    Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, JointOutcome, JointScratch,
-    JointSettings, ProjectionOutcome, ProjectionSettings, RowImpulse, project_island,
-    project_jointly,
+    Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, JointOutcome, JointSettings,
+    ProjectionSettings, RowImpulse, project_island,
 };
 use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
@@ -19,6 +20,7 @@ use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::topology::{Topology, rebuild_topology};
+use joint_driver::JointDriver;
 
 /// The islands of the current topology and the solver's reusable buffers.
 #[derive(Resource, Default, Debug)]
@@ -34,11 +36,7 @@ pub struct Islands {
     pub unsolved: Vec<usize>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
-    joint: JointScratch,
-    joint_islands: Vec<u32>,
-    joint_loose: Vec<u32>,
-    /// Which islands (then which particles) the current joint projection takes.
-    joint_marks: Vec<bool>,
+    joint: JointDriver,
     lanes: Vec<Lane>,
     /// Each topology edge's impulse this step, summed over every projection of the
     /// step (mass × length, tension positive): see [`Islands::edge_tension`].
@@ -208,7 +206,8 @@ impl Islands {
 
     /// Project jointly every island that `rows` touch, and the loose free particles
     /// they touch, with the rows: both sides of every contact move, each island as a
-    /// whole (see [`project_jointly`]). `island` gives each particle's island, as
+    /// whole (see [`project_jointly`](super::projection::project_jointly)), each
+    /// independent group on its own and on up to `threads` threads. `island` gives each particle's island, as
     /// [`Topology::island`] does; `impulses[c]` is row c's warm start on entry and its
     /// total impulse on return. `outcomes` tells, for each island projected, whether
     /// it met its edges.
@@ -223,72 +222,21 @@ impl Islands {
         settings: &JointSettings,
         stats: &mut IterationStats,
         outcomes: &mut Vec<(u32, bool)>,
+        threads: usize,
     ) -> JointOutcome {
-        outcomes.clear();
-        self.joint_islands.clear();
-        self.joint_loose.clear();
-        // Each island and loose particle once (marked while collecting), so the lists
-        // never outgrow the islands and particles they were sized for.
-        self.joint_marks
-            .resize(self.set.islands.len() + island.len(), false);
-        let islands = self.set.islands.len();
-        for row in rows {
-            for &p in &row.particles {
-                let (slot, list, id) = match island_of(island, p as usize) {
-                    Some(i) => (i, &mut self.joint_islands, i as u32),
-                    None if bodies.inverse_mass[p as usize] > 0.0 => {
-                        (islands + p as usize, &mut self.joint_loose, p)
-                    }
-                    None => continue,
-                };
-                if !self.joint_marks[slot] {
-                    self.joint_marks[slot] = true;
-                    list.push(id);
-                }
-            }
-        }
-        for &i in &self.joint_islands {
-            self.joint_marks[i as usize] = false;
-        }
-        for &p in &self.joint_loose {
-            self.joint_marks[islands + p as usize] = false;
-        }
-        for list in [&mut self.joint_islands, &mut self.joint_loose] {
-            list.sort_unstable();
-        }
-        if self.joint_islands.is_empty() && self.joint_loose.is_empty() {
-            return JointOutcome {
-                converged: true,
-                ..Default::default()
-            };
-        }
-        let outcome = project_jointly(
+        self.joint.project(
             &self.set,
-            &self.joint_islands,
-            &self.joint_loose,
-            bodies.reborrow(),
+            island,
+            bodies,
             rows,
             impulses,
             dt,
             settings,
-            &mut self.joint,
-        );
-        for (i, &member) in self.joint_islands.iter().enumerate() {
-            outcomes.push((member, self.joint.island_met(i)));
-            let edges = &self.set.edges[self.set.islands[member as usize].edges.clone()];
-            for (e, j) in edges.iter().zip(self.joint.edge_impulses(i)) {
-                if let Some(slot) = self.impulse.get_mut(e.edge as usize) {
-                    *slot += j;
-                }
-            }
-        }
-        stats.record(&ProjectionOutcome {
-            iterations: outcome.iterations,
-            converged: outcome.converged,
-            residual: outcome.residual,
-            ..Default::default()
-        });
-        outcome
+            threads,
+            stats,
+            outcomes,
+            &mut self.impulse,
+        )
     }
 
     /// Forget the last step's impulses (sized to the topology at its rebuild).
@@ -328,15 +276,6 @@ fn project_met(
     }
     stats.record(&outcome);
     outcome.converged && !outcome.rejected && !outcome.singular
-}
-
-/// The island of `particle`, if it is in one.
-fn island_of(island: &[u32], particle: usize) -> Option<usize> {
-    island
-        .get(particle)
-        .copied()
-        .filter(|&i| i != NO_ISLAND)
-        .map(|i| i as usize)
 }
 
 /// Islands, the Constrain stage and its settings.
@@ -418,9 +357,7 @@ pub fn rebuild_islands(
     }
     islands.scratch.reserve(longest, most_particles);
     let (count, particles) = (set.islands.len(), topology.pinned.len());
-    islands.joint_islands.reserve(count);
-    islands.joint_loose.reserve(particles);
-    islands.joint_marks.resize(count + particles, false);
+    islands.joint.reserve(count, particles);
     islands.relaxation.reserve(topology.pinned.len(), longest);
     topology.island.clear();
     topology.island.resize(topology.pinned.len(), NO_ISLAND);

@@ -1,0 +1,349 @@
+//! Driving the joint projection of islands in contact: which islands and loose
+//! particles the rows touch, their independent groups ([`JointGroups`]), and each group
+//! projected on its own — on several threads when there are enough rows. A group
+//! reads and writes only its own particles (the rows' other particles are pinned or
+//! driven), so the result is the same bit for bit whatever the thread count.
+
+use std::ops::Range;
+
+use bevy::math::DVec2;
+
+use crate::constraints::islands::IslandSet;
+use crate::constraints::joint_groups::{JointGroups, NONE, RowSlots};
+use crate::constraints::projection::{
+    Bodies, ContactRow, JointOutcome, JointScratch, JointSettings, ProjectionOutcome, RowImpulse,
+    project_jointly,
+};
+use crate::metrics::IterationStats;
+use crate::model::NO_ISLAND;
+
+/// Below this many rows a joint projection stays on one thread.
+const PARALLEL_ROWS: usize = 512;
+
+/// The buffers of joint projections, reused every step.
+#[derive(Default, Debug)]
+pub(super) struct JointDriver {
+    /// Islands, then loose particles, that the current rows touch (sorted).
+    islands: Vec<u32>,
+    loose: Vec<u32>,
+    /// Which islands (then which particles) are taken, while collecting.
+    marks: Vec<bool>,
+    row_slots: Vec<RowSlots>,
+    groups: JointGroups,
+    /// The first lane is the calling thread's.
+    lanes: Vec<Lane>,
+    /// The velocities before the lanes ran.
+    before: Vec<DVec2>,
+    rows_per_group: Vec<usize>,
+}
+
+/// One thread's groups and buffers.
+#[derive(Default, Debug)]
+struct Lane {
+    scratch: JointScratch,
+    groups: Range<u32>,
+    velocity: Vec<DVec2>,
+    members: Vec<u32>,
+    loose: Vec<u32>,
+    rows: Vec<ContactRow>,
+    impulses: Vec<RowImpulse>,
+    /// (row, its impulse) of every row the lane projected, in group order.
+    taken: Vec<(u32, RowImpulse)>,
+    /// (topology edge, impulse) of the lane's islands, in group order.
+    edge_impulses: Vec<(u32, f64)>,
+    outcomes: Vec<(u32, bool)>,
+    stats: IterationStats,
+    total: JointOutcome,
+}
+
+/// What every group's projection reads.
+struct Shared<'a> {
+    set: &'a IslandSet,
+    islands: &'a [u32],
+    loose: &'a [u32],
+    groups: &'a JointGroups,
+    rows: &'a [ContactRow],
+    impulses: &'a [RowImpulse],
+    dt: f64,
+    settings: &'a JointSettings,
+}
+
+impl JointDriver {
+    /// Room for `islands` islands and `particles` particles.
+    pub(super) fn reserve(&mut self, islands: usize, particles: usize) {
+        self.islands.reserve(islands);
+        self.loose.reserve(particles);
+        self.marks.resize(islands + particles, false);
+    }
+
+    /// Project jointly every island `rows` touch (`island` gives each particle's
+    /// island) and the loose free particles they touch: each member's outcome into
+    /// `outcomes`, its edges' impulses added to `edge_impulse`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn project(
+        &mut self,
+        set: &IslandSet,
+        island: &[u32],
+        bodies: &mut Bodies,
+        rows: &[ContactRow],
+        impulses: &mut [RowImpulse],
+        dt: f64,
+        settings: &JointSettings,
+        threads: usize,
+        stats: &mut IterationStats,
+        outcomes: &mut Vec<(u32, bool)>,
+        edge_impulse: &mut [f64],
+    ) -> JointOutcome {
+        outcomes.clear();
+        self.collect(set.islands.len(), island, bodies, rows);
+        if self.islands.is_empty() && self.loose.is_empty() {
+            return JointOutcome {
+                converged: true,
+                ..Default::default()
+            };
+        }
+        self.group(island, rows);
+        let groups = self.groups.count as u32;
+        let lanes = if rows.len() < PARALLEL_ROWS {
+            1
+        } else {
+            threads.clamp(1, groups.max(1) as usize)
+        };
+        self.split(lanes, rows.len());
+        let shared = Shared {
+            set,
+            islands: &self.islands,
+            loose: &self.loose,
+            groups: &self.groups,
+            rows,
+            impulses,
+            dt,
+            settings,
+        };
+        let (first, rest) = self.lanes[..lanes].split_at_mut(1);
+        let first = &mut first[0];
+        if rest.is_empty() {
+            first.run(&shared, bodies.reborrow());
+        } else {
+            let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
+            self.before.clear();
+            self.before.extend_from_slice(bodies.velocity);
+            for lane in rest.iter_mut() {
+                lane.velocity.clear();
+                lane.velocity.extend_from_slice(bodies.velocity);
+            }
+            let shared = &shared;
+            std::thread::scope(|scope| {
+                for lane in rest.iter_mut() {
+                    scope.spawn(move || {
+                        let mut velocity = std::mem::take(&mut lane.velocity);
+                        lane.run(shared, Bodies::new(position, &mut velocity, inverse_mass));
+                        lane.velocity = velocity;
+                    });
+                }
+                first.run(shared, bodies.reborrow());
+            });
+            // Each particle is projected by one lane at most: copy what the others changed.
+            let bits = |v: &DVec2| v.to_array().map(f64::to_bits);
+            for lane in rest.iter() {
+                for ((v, own), before) in (bodies.velocity.iter_mut())
+                    .zip(&lane.velocity)
+                    .zip(&self.before)
+                {
+                    if bits(own) != bits(before) {
+                        *v = *own;
+                    }
+                }
+            }
+        }
+        // A row that touches no member carries nothing.
+        for (slot, &group) in impulses.iter_mut().zip(&self.groups.row_group) {
+            if group == NONE {
+                *slot = RowImpulse::default();
+            }
+        }
+        // Merge in group order: the same sums in the same order whatever the lanes.
+        let mut total = JointOutcome {
+            converged: true,
+            ..Default::default()
+        };
+        for lane in &self.lanes[..lanes] {
+            for &(c, impulse) in &lane.taken {
+                if let Some(slot) = impulses.get_mut(c as usize) {
+                    *slot = impulse;
+                }
+            }
+            for &(edge, j) in &lane.edge_impulses {
+                if let Some(slot) = edge_impulse.get_mut(edge as usize) {
+                    *slot += j;
+                }
+            }
+            outcomes.extend_from_slice(&lane.outcomes);
+            stats.merge(&lane.stats);
+            total.iterations = total.iterations.max(lane.total.iterations);
+            total.sweeps += lane.total.sweeps;
+            total.converged &= lane.total.converged;
+            total.residual = total.residual.max(lane.total.residual);
+            total.contact_violation = total.contact_violation.max(lane.total.contact_violation);
+        }
+        total
+    }
+
+    /// The islands, then the loose free particles, that `rows` touch, each once.
+    fn collect(&mut self, islands: usize, island: &[u32], bodies: &Bodies, rows: &[ContactRow]) {
+        self.islands.clear();
+        self.loose.clear();
+        self.marks.resize(islands + island.len(), false);
+        for row in rows {
+            for &p in &row.particles {
+                let (slot, list, id) = match island_of(island, p as usize) {
+                    Some(i) => (i, &mut self.islands, i as u32),
+                    None if bodies.inverse_mass[p as usize] > 0.0 => {
+                        (islands + p as usize, &mut self.loose, p)
+                    }
+                    None => continue,
+                };
+                if !self.marks[slot] {
+                    self.marks[slot] = true;
+                    list.push(id);
+                }
+            }
+        }
+        for &i in &self.islands {
+            self.marks[i as usize] = false;
+        }
+        for &p in &self.loose {
+            self.marks[islands + p as usize] = false;
+        }
+        self.islands.sort_unstable();
+        self.loose.sort_unstable();
+    }
+
+    /// Group the members (the islands, then the loose particles, by position) as
+    /// `rows` join them.
+    fn group(&mut self, island: &[u32], rows: &[ContactRow]) {
+        let (members, loose) = (&self.islands, &self.loose);
+        let slot = |p: u32| -> u32 {
+            let found = match island_of(island, p as usize) {
+                Some(i) => members.binary_search(&(i as u32)).ok(),
+                None => loose.binary_search(&p).ok().map(|k| members.len() + k),
+            };
+            found.map_or(NONE, |k| k as u32)
+        };
+        self.row_slots.clear();
+        (self.row_slots).extend(rows.iter().map(|row| row.particles.map(slot)));
+        self.groups
+            .partition(members.len() + loose.len(), &self.row_slots);
+    }
+
+    /// Give `lanes` lanes contiguous runs of groups of about equal rows.
+    fn split(&mut self, lanes: usize, rows: usize) {
+        if self.lanes.len() < lanes {
+            self.lanes.resize_with(lanes, Lane::default);
+        }
+        let per_group = &mut self.rows_per_group;
+        per_group.clear();
+        per_group.resize(self.groups.count, 0);
+        for &g in &self.groups.row_group {
+            if g != NONE {
+                per_group[g as usize] += 1;
+            }
+        }
+        let mut start = 0u32;
+        let mut seen = 0usize;
+        for (k, lane) in self.lanes[..lanes].iter_mut().enumerate() {
+            let mut end = start;
+            let share = rows * (k + 1) / lanes;
+            while (end as usize) < per_group.len() && (seen < share || k + 1 == lanes) {
+                seen += per_group[end as usize];
+                end += 1;
+            }
+            lane.groups = start..end;
+            start = end;
+        }
+    }
+}
+
+impl Lane {
+    /// Project this lane's groups one after another.
+    fn run(&mut self, shared: &Shared, mut bodies: Bodies) {
+        self.taken.clear();
+        self.edge_impulses.clear();
+        self.outcomes.clear();
+        self.stats = IterationStats::default();
+        self.total = JointOutcome {
+            converged: true,
+            ..Default::default()
+        };
+        let slots = &shared.groups.slot_group;
+        let ni = shared.islands.len();
+        for g in self.groups.clone() {
+            self.members.clear();
+            self.loose.clear();
+            let of_group = |k: usize| slots[k] == g;
+            (self.members).extend(
+                (shared.islands.iter().enumerate())
+                    .filter(|&(k, _)| of_group(k))
+                    .map(|(_, &i)| i),
+            );
+            (self.loose).extend(
+                (shared.loose.iter().enumerate())
+                    .filter(|&(k, _)| of_group(ni + k))
+                    .map(|(_, &p)| p),
+            );
+            self.rows.clear();
+            self.impulses.clear();
+            let first_taken = self.taken.len();
+            for (c, (row, &group)) in shared.rows.iter().zip(&shared.groups.row_group).enumerate() {
+                if group == g {
+                    self.rows.push(*row);
+                    self.impulses
+                        .push(shared.impulses.get(c).copied().unwrap_or_default());
+                    self.taken.push((c as u32, RowImpulse::default()));
+                }
+            }
+            let outcome = project_jointly(
+                shared.set,
+                &self.members,
+                &self.loose,
+                bodies.reborrow(),
+                &self.rows,
+                &mut self.impulses,
+                shared.dt,
+                shared.settings,
+                &mut self.scratch,
+            );
+            for (taken, &impulse) in self.taken[first_taken..].iter_mut().zip(&self.impulses) {
+                taken.1 = impulse;
+            }
+            for (i, &member) in self.members.iter().enumerate() {
+                self.outcomes.push((member, self.scratch.island_met(i)));
+                let edges = &shared.set.edges[shared.set.islands[member as usize].edges.clone()];
+                for (e, &j) in edges.iter().zip(self.scratch.edge_impulses(i)) {
+                    self.edge_impulses.push((e.edge, j));
+                }
+            }
+            self.stats.record(&ProjectionOutcome {
+                iterations: outcome.iterations,
+                converged: outcome.converged,
+                residual: outcome.residual,
+                ..Default::default()
+            });
+            self.total.iterations = self.total.iterations.max(outcome.iterations);
+            self.total.sweeps += outcome.sweeps;
+            self.total.converged &= outcome.converged;
+            self.total.residual = self.total.residual.max(outcome.residual);
+            self.total.contact_violation =
+                (self.total.contact_violation).max(outcome.contact_violation);
+        }
+    }
+}
+
+/// The island of `particle`, if it is in one.
+fn island_of(island: &[u32], particle: usize) -> Option<usize> {
+    island
+        .get(particle)
+        .copied()
+        .filter(|&i| i != NO_ISLAND)
+        .map(|i| i as usize)
+}
