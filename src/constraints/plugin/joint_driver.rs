@@ -110,48 +110,66 @@ impl JointDriver {
             threads.clamp(1, groups.max(1) as usize)
         };
         self.split(lanes, rows.len());
-        let shared = Shared {
-            set,
-            islands: &self.islands,
-            loose: &self.loose,
-            groups: &self.groups,
-            rows,
-            impulses,
-            dt,
-            settings,
-        };
-        let (first, rest) = self.lanes[..lanes].split_at_mut(1);
-        let first = &mut first[0];
-        if rest.is_empty() {
-            first.run(&shared, bodies.reborrow());
+        if groups <= 1 {
+            // One group: projected in place, as it comes.
+            let lane = &mut self.lanes[0];
+            lane.begin();
+            let outcome = project_jointly(
+                set,
+                &self.islands,
+                &self.loose,
+                bodies.reborrow(),
+                rows,
+                impulses,
+                dt,
+                settings,
+                &mut lane.scratch,
+            );
+            lane.account(set, &self.islands, &outcome);
         } else {
-            let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
-            self.before.clear();
-            self.before.extend_from_slice(bodies.velocity);
-            for lane in rest.iter_mut() {
-                lane.velocity.clear();
-                lane.velocity.extend_from_slice(bodies.velocity);
-            }
-            let shared = &shared;
-            std::thread::scope(|scope| {
+            let shared = Shared {
+                set,
+                islands: &self.islands,
+                loose: &self.loose,
+                groups: &self.groups,
+                rows,
+                impulses,
+                dt,
+                settings,
+            };
+            let (first, rest) = self.lanes[..lanes].split_at_mut(1);
+            let first = &mut first[0];
+            if rest.is_empty() {
+                first.run(&shared, bodies.reborrow());
+            } else {
+                let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
+                self.before.clear();
+                self.before.extend_from_slice(bodies.velocity);
                 for lane in rest.iter_mut() {
-                    scope.spawn(move || {
-                        let mut velocity = std::mem::take(&mut lane.velocity);
-                        lane.run(shared, Bodies::new(position, &mut velocity, inverse_mass));
-                        lane.velocity = velocity;
-                    });
+                    lane.velocity.clear();
+                    lane.velocity.extend_from_slice(bodies.velocity);
                 }
-                first.run(shared, bodies.reborrow());
-            });
-            // Each particle is projected by one lane at most: copy what the others changed.
-            let bits = |v: &DVec2| v.to_array().map(f64::to_bits);
-            for lane in rest.iter() {
-                for ((v, own), before) in (bodies.velocity.iter_mut())
-                    .zip(&lane.velocity)
-                    .zip(&self.before)
-                {
-                    if bits(own) != bits(before) {
-                        *v = *own;
+                let shared = &shared;
+                std::thread::scope(|scope| {
+                    for lane in rest.iter_mut() {
+                        scope.spawn(move || {
+                            let mut velocity = std::mem::take(&mut lane.velocity);
+                            lane.run(shared, Bodies::new(position, &mut velocity, inverse_mass));
+                            lane.velocity = velocity;
+                        });
+                    }
+                    first.run(shared, bodies.reborrow());
+                });
+                // Each particle is projected by one lane at most: copy what the others changed.
+                let bits = |v: &DVec2| v.to_array().map(f64::to_bits);
+                for lane in rest.iter() {
+                    for ((v, own), before) in (bodies.velocity.iter_mut())
+                        .zip(&lane.velocity)
+                        .zip(&self.before)
+                    {
+                        if bits(own) != bits(before) {
+                            *v = *own;
+                        }
                     }
                 }
             }
@@ -267,14 +285,7 @@ impl JointDriver {
 impl Lane {
     /// Project this lane's groups one after another.
     fn run(&mut self, shared: &Shared, mut bodies: Bodies) {
-        self.taken.clear();
-        self.edge_impulses.clear();
-        self.outcomes.clear();
-        self.stats = IterationStats::default();
-        self.total = JointOutcome {
-            converged: true,
-            ..Default::default()
-        };
+        self.begin();
         let slots = &shared.groups.slot_group;
         let ni = shared.islands.len();
         for g in self.groups.clone() {
@@ -316,26 +327,45 @@ impl Lane {
             for (taken, &impulse) in self.taken[first_taken..].iter_mut().zip(&self.impulses) {
                 taken.1 = impulse;
             }
-            for (i, &member) in self.members.iter().enumerate() {
-                self.outcomes.push((member, self.scratch.island_met(i)));
-                let edges = &shared.set.edges[shared.set.islands[member as usize].edges.clone()];
-                for (e, &j) in edges.iter().zip(self.scratch.edge_impulses(i)) {
-                    self.edge_impulses.push((e.edge, j));
-                }
-            }
-            self.stats.record(&ProjectionOutcome {
-                iterations: outcome.iterations,
-                converged: outcome.converged,
-                residual: outcome.residual,
-                ..Default::default()
-            });
-            self.total.iterations = self.total.iterations.max(outcome.iterations);
-            self.total.sweeps += outcome.sweeps;
-            self.total.converged &= outcome.converged;
-            self.total.residual = self.total.residual.max(outcome.residual);
-            self.total.contact_violation =
-                (self.total.contact_violation).max(outcome.contact_violation);
+            let members = std::mem::take(&mut self.members);
+            self.account(shared.set, &members, &outcome);
+            self.members = members;
         }
+    }
+
+    /// Empty the lane's results.
+    fn begin(&mut self) {
+        self.taken.clear();
+        self.edge_impulses.clear();
+        self.outcomes.clear();
+        self.stats = IterationStats::default();
+        self.total = JointOutcome {
+            converged: true,
+            ..Default::default()
+        };
+    }
+
+    /// Keep the results of a projection of `members` (still in the scratch).
+    fn account(&mut self, set: &IslandSet, members: &[u32], outcome: &JointOutcome) {
+        for (i, &member) in members.iter().enumerate() {
+            self.outcomes.push((member, self.scratch.island_met(i)));
+            let edges = &set.edges[set.islands[member as usize].edges.clone()];
+            for (e, &j) in edges.iter().zip(self.scratch.edge_impulses(i)) {
+                self.edge_impulses.push((e.edge, j));
+            }
+        }
+        self.stats.record(&ProjectionOutcome {
+            iterations: outcome.iterations,
+            converged: outcome.converged,
+            residual: outcome.residual,
+            ..Default::default()
+        });
+        self.total.iterations = self.total.iterations.max(outcome.iterations);
+        self.total.sweeps += outcome.sweeps;
+        self.total.converged &= outcome.converged;
+        self.total.residual = self.total.residual.max(outcome.residual);
+        self.total.contact_violation =
+            (self.total.contact_violation).max(outcome.contact_violation);
     }
 }
 
