@@ -22,6 +22,13 @@ pub struct JointGroups {
     pub row_group: Vec<u32>,
     /// Groups found, numbered in the order of their smallest slot.
     pub count: usize,
+    /// Slots, then rows, bucketed by group (each bucket in index order), and where
+    /// each group's bucket starts (`count + 1` entries).
+    slot_order: Vec<u32>,
+    slot_start: Vec<u32>,
+    row_order: Vec<u32>,
+    row_start: Vec<u32>,
+    cursor: Vec<u32>,
 }
 
 impl JointGroups {
@@ -56,6 +63,60 @@ impl JointGroups {
                 .find(|&&s| s != NONE)
                 .map_or(NONE, |&s| self.slot_group[s as usize])
         }));
+        let cursor = &mut self.cursor;
+        bucket(
+            &self.slot_group,
+            self.count,
+            &mut self.slot_order,
+            &mut self.slot_start,
+            cursor,
+        );
+        bucket(
+            &self.row_group,
+            self.count,
+            &mut self.row_order,
+            &mut self.row_start,
+            cursor,
+        );
+    }
+
+    /// The slots of group `g`, ascending.
+    pub fn slots_of(&self, g: u32) -> &[u32] {
+        let g = g as usize;
+        &self.slot_order[self.slot_start[g] as usize..self.slot_start[g + 1] as usize]
+    }
+
+    /// The rows of group `g`, ascending.
+    pub fn rows_of(&self, g: u32) -> &[u32] {
+        let g = g as usize;
+        &self.row_order[self.row_start[g] as usize..self.row_start[g + 1] as usize]
+    }
+}
+
+/// Indices of `group` bucketed by group (a counting sort, so each bucket keeps index
+/// order; `NONE` left out) and the buckets' starts; `cursor` is scratch.
+fn bucket(
+    group: &[u32],
+    count: usize,
+    order: &mut Vec<u32>,
+    start: &mut Vec<u32>,
+    cursor: &mut Vec<u32>,
+) {
+    start.clear();
+    start.resize(count + 1, 0);
+    for &g in group.iter().filter(|&&g| g != NONE) {
+        start[g as usize + 1] += 1;
+    }
+    for g in 0..count {
+        start[g + 1] += start[g];
+    }
+    order.clear();
+    order.resize(start[count] as usize, 0);
+    cursor.clear();
+    cursor.extend_from_slice(start);
+    for (i, &g) in group.iter().enumerate().filter(|&(_, &g)| g != NONE) {
+        order[cursor[g as usize] as usize] = i as u32;
+        cursor[g as usize] += 1;
     }
 }
 
@@ -104,6 +165,10 @@ mod tests {
         assert_eq!(groups.count, 6);
         assert_eq!(groups.slot_group, vec![0, 1, 2, 3, 4, 3, 5, 1, 3]);
         assert_eq!(groups.row_group, vec![3, NONE, 1, 3, 0]);
+        assert_eq!(groups.slots_of(3), &[3, 5, 8]);
+        assert_eq!(groups.slots_of(1), &[1, 7]);
+        assert_eq!(groups.rows_of(3), &[0, 3]);
+        assert_eq!(groups.rows_of(5), &[] as &[u32]);
     }
 
     #[test]

@@ -34,7 +34,6 @@ pub(super) struct JointDriver {
     lanes: Vec<Lane>,
     /// The velocities before the lanes ran.
     before: Vec<DVec2>,
-    rows_per_group: Vec<usize>,
 }
 
 /// One thread's groups and buffers.
@@ -259,21 +258,13 @@ impl JointDriver {
         if self.lanes.len() < lanes {
             self.lanes.resize_with(lanes, Lane::default);
         }
-        let per_group = &mut self.rows_per_group;
-        per_group.clear();
-        per_group.resize(self.groups.count, 0);
-        for &g in &self.groups.row_group {
-            if g != NONE {
-                per_group[g as usize] += 1;
-            }
-        }
         let mut start = 0u32;
         let mut seen = 0usize;
         for (k, lane) in self.lanes[..lanes].iter_mut().enumerate() {
             let mut end = start;
             let share = rows * (k + 1) / lanes;
-            while (end as usize) < per_group.len() && (seen < share || k + 1 == lanes) {
-                seen += per_group[end as usize];
+            while (end as usize) < self.groups.count && (seen < share || k + 1 == lanes) {
+                seen += self.groups.rows_of(end).len();
                 end += 1;
             }
             lane.groups = start..end;
@@ -286,32 +277,24 @@ impl Lane {
     /// Project this lane's groups one after another.
     fn run(&mut self, shared: &Shared, mut bodies: Bodies) {
         self.begin();
-        let slots = &shared.groups.slot_group;
         let ni = shared.islands.len();
         for g in self.groups.clone() {
             self.members.clear();
             self.loose.clear();
-            let of_group = |k: usize| slots[k] == g;
-            (self.members).extend(
-                (shared.islands.iter().enumerate())
-                    .filter(|&(k, _)| of_group(k))
-                    .map(|(_, &i)| i),
-            );
-            (self.loose).extend(
-                (shared.loose.iter().enumerate())
-                    .filter(|&(k, _)| of_group(ni + k))
-                    .map(|(_, &p)| p),
-            );
+            // Slots ascend: the islands (by id), then the loose particles (by index).
+            for &slot in shared.groups.slots_of(g) {
+                match (slot as usize).checked_sub(ni) {
+                    None => self.members.push(shared.islands[slot as usize]),
+                    Some(k) => self.loose.push(shared.loose[k]),
+                }
+            }
             self.rows.clear();
             self.impulses.clear();
             let first_taken = self.taken.len();
-            for (c, (row, &group)) in shared.rows.iter().zip(&shared.groups.row_group).enumerate() {
-                if group == g {
-                    self.rows.push(*row);
-                    self.impulses
-                        .push(shared.impulses.get(c).copied().unwrap_or_default());
-                    self.taken.push((c as u32, RowImpulse::default()));
-                }
+            for &c in shared.groups.rows_of(g) {
+                self.rows.push(shared.rows[c as usize]);
+                (self.impulses).push(shared.impulses.get(c as usize).copied().unwrap_or_default());
+                self.taken.push((c, RowImpulse::default()));
             }
             let outcome = project_jointly(
                 shared.set,
