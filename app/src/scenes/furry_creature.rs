@@ -6,6 +6,7 @@ use std::f64::consts::TAU;
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use bevy_strands::colliders::outline;
 use bevy_strands::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -132,8 +133,9 @@ pub fn spawn_furry_creature(world: &mut World, spec: FurryCreatureSpec) -> Entit
 }
 
 /// The body's collision outline: a pinned wall polygon circumscribing the circle of
-/// `radius` about the body's centre (within [`OUTLINE_TOLERANCE`]), driven like the
-/// roots. Returns its particles and their offsets from the centre.
+/// `radius` about the body's centre (the library's collider outline, within
+/// [`OUTLINE_TOLERANCE`]), driven like the roots. Returns its particles and their
+/// offsets from the centre.
 fn spawn_body_outline(
     world: &mut World,
     spec: &FurryCreatureSpec,
@@ -142,18 +144,16 @@ fn spawn_body_outline(
     if !radius.is_finite() || radius <= 0.0 {
         return Err(format!("body_inset leaves a radius of {radius}"));
     }
-    // A side spanning θ stands r (1 / cos(θ/2) − 1) off the circle at its corners.
-    let per_side = 2.0 * (radius / (radius + OUTLINE_TOLERANCE)).acos();
-    let sides = ((TAU / per_side).ceil() as usize).max(3);
-    let corner = radius / (0.5 * TAU / sides as f64).cos();
-    let offsets: Vec<DVec2> = (0..sides)
-        .map(|k| corner * DVec2::from_angle(TAU * k as f64 / sides as f64))
-        .collect();
+    let circle = ColliderShape::Circle {
+        radius: radius as f32,
+    };
+    let (corners, _) = outline(&circle, OUTLINE_TOLERANCE as f32);
+    let offsets: Vec<DVec2> = corners.iter().map(|c| c.as_dvec2()).collect();
     let start = spec.body_centre(0.0);
     let mut builder = StrandBuilder::closed_loop(offsets.iter().map(|&o| start + o))
         .kind(StrandKind::Wall)
         .material(StrandMaterial::INERT);
-    for k in 0..sides {
+    for k in 0..offsets.len() {
         builder = builder.pin(k);
     }
     let strand = builder.spawn_in(world).map_err(|e| e.to_string())?;
