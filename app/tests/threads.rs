@@ -15,10 +15,19 @@ fn figures(report: &Report) -> serde_json::Value {
     value
 }
 
+/// The run `options(threads)` gives on one thread and on two: the same report.
+fn same_on_one_and_two_threads(options: impl Fn(usize) -> RunOptions) -> Report {
+    let one = run(&options(1), |_| {}).unwrap();
+    let two = run(&options(2), |_| {}).unwrap();
+    assert_eq!((one.threads, two.threads), (1, 2));
+    assert_eq!(figures(&one), figures(&two));
+    one
+}
+
 /// `scale` with `strands` strands of 100 particles for `seconds`, on one thread and
 /// on two: the same report.
 fn same_report_on_one_and_two_threads(strands: usize, seconds: f64) -> Report {
-    let options = |threads| RunOptions {
+    let one = same_on_one_and_two_threads(|threads| RunOptions {
         scenario: "scale".into(),
         strands: Some(strands),
         particles: Some(100),
@@ -26,11 +35,7 @@ fn same_report_on_one_and_two_threads(strands: usize, seconds: f64) -> Report {
         threads: Some(threads),
         check_crossings: true,
         ..Default::default()
-    };
-    let one = run(&options(1), |_| {}).unwrap();
-    let two = run(&options(2), |_| {}).unwrap();
-    assert_eq!((one.threads, two.threads), (1, 2));
-    assert_eq!(figures(&one), figures(&two));
+    });
     assert!(
         one.max_rel_length_error < 1e-9,
         "{}",
@@ -84,17 +89,13 @@ fn a_rerun_gives_the_same_report_bit_for_bit() {
 fn the_joint_groups_shared_between_threads_give_the_same_report() {
     // The dense pile: thousands of contact rows a step in many independent groups,
     // projected on two lanes with two threads.
-    let options = |threads| RunOptions {
+    let one = same_on_one_and_two_threads(|threads| RunOptions {
         scenario: "pile".into(),
         seconds: Some(0.3),
         threads: Some(threads),
         check_crossings: true,
         ..Default::default()
-    };
-    let one = run(&options(1), |_| {}).unwrap();
-    let two = run(&options(2), |_| {}).unwrap();
-    assert_eq!((one.threads, two.threads), (1, 2));
-    assert_eq!(figures(&one), figures(&two));
+    });
     // More joint projections than steps: the steps' rows fell into several groups.
     assert!(
         one.contact_projection_solves > 2 * one.steps,
