@@ -200,18 +200,6 @@ fn link_responses<W: Walk>(c: usize, link: usize, walk: Option<W>, s: &mut Joint
 /// The sweeps over the rows.
 pub(super) struct Sweeps;
 
-/// From the [`MIN_SWEEPS`]th sweep on, a sweep that leaves the worst row's shortfall
-/// above this share of the sweep before's ends the Newton step's sweeps: projected
-/// Gauss–Seidel has stalled on this linearization (rows that ask the edges for more
-/// than they allow, a packed pile), and the cap's remaining sweeps would cost the most
-/// of a step and gain nothing; the next Newton step re-linearizes. Measured on the
-/// dense pile and the fur: 87 and 54 sweeps a projection before, 16 and 10 after, the
-/// rows as well met (docs/step-size.md).
-const STALL: f64 = 0.95;
-
-/// Sweeps always done before [`STALL`] may end them.
-const MIN_SWEEPS: u32 = 3;
-
 /// Along the normal or the tangent.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Along {
@@ -260,7 +248,6 @@ impl Sweeps {
             }
         }
         let mut sweeps = 0;
-        let mut previous_worst = f64::INFINITY;
         while sweeps < cap {
             sweeps += 1;
             let mut worst = 0.0f64;
@@ -298,10 +285,9 @@ impl Sweeps {
                 row.mu_t += change_t;
                 apply(s, c, change_n, change_t);
             }
-            if worst <= tolerance || (sweeps >= MIN_SWEEPS && worst > STALL * previous_worst) {
+            if worst <= tolerance {
                 break;
             }
-            previous_worst = worst;
         }
         multipliers(s);
         sweeps
