@@ -19,9 +19,15 @@ pub struct SingularPivot {
 /// `lower[0]` and `upper[n−1]` are ignored. `scratch` holds at least `n` values.
 /// Allocates nothing.
 ///
-/// Eliminates from both ends at once and meets in the middle (a twisted
-/// factorization): Thomas' cost is the latency of its chain of divisions, one per
-/// row, and two independent chains of half the length overlap in the processor.
+/// Thomas' cost is latency: each row's pivot needs the division by the one before.
+/// Two things take the divisions off that chain. The elimination runs from both ends
+/// at once and meets in the middle (a twisted factorization), two independent chains
+/// of half the length. And each chain carries the leading minors `q_k = d_k q_{k−1} −
+/// l_k u_{k−1} q_{k−2}` (pivot `q_k / q_{k−1}`) and the scaled right-hand side
+/// `Y_k = q_{k−1} b_k − l_k Y_{k−1}` (eliminated value `Y_k / q_k`): multiplications
+/// only, with one reciprocal per row that nothing later in the chain waits for. The
+/// minors are rescaled by powers of two every few rows, exactly, so they never
+/// overflow or underflow.
 pub fn solve_tridiagonal(
     lower: &[f64],
     diagonal: &[f64],
@@ -45,28 +51,47 @@ pub fn solve_tridiagonal(
     let m = n / 2;
     let pairs = last - m; // rows below the middle; the rows above are `m` >= `pairs`
     let mut healthy = true;
-    let mut above = (0.0, 0.0); // (scratch, rhs) of the row just eliminated downwards
-    let mut below = (0.0, 0.0); // the same upwards
+    let mut chains = Chains::default();
     for k in 0..m {
-        let coupling = if k > 0 { lower[k] } else { 0.0 };
-        let pivot = diagonal[k] - coupling * above.0;
-        healthy &= usable(pivot, coupling.abs() + diagonal[k].abs() + upper[k].abs());
-        let inverse = 1.0 / pivot;
-        above = (upper[k] * inverse, (rhs[k] - coupling * above.1) * inverse);
-        (scratch[k], rhs[k]) = above;
-        if k < pairs {
-            let j = last - k;
-            let coupling = if k > 0 { upper[j] } else { 0.0 };
-            let pivot = diagonal[j] - coupling * below.0;
-            healthy &= usable(pivot, coupling.abs() + diagonal[j].abs() + lower[j].abs());
-            let inverse = 1.0 / pivot;
-            below = (lower[j] * inverse, (rhs[j] - coupling * below.1) * inverse);
-            (scratch[j], rhs[j]) = below;
+        // Lane 0: row k from above, coupled to k − 1 by lower[k] and to k + 1 by
+        // upper[k]. Lane 1: row j = last − k from below, coupled to j + 1 by upper[j]
+        // and to j − 1 by lower[j]; an idle row (1 on the diagonal) when the rows
+        // above outnumber those below.
+        let j = last - k;
+        let paired = k < pairs;
+        let (inward, linked) = match (k > 0, paired) {
+            (false, _) => ([0.0; 2], [0.0; 2]),
+            (true, true) => (
+                [lower[k], upper[j]],
+                [lower[k] * upper[k - 1], upper[j] * lower[j + 1]],
+            ),
+            (true, false) => ([lower[k], 0.0], [lower[k] * upper[k - 1], 0.0]),
+        };
+        let (diagonal, outward, b) = if paired {
+            (
+                [diagonal[k], diagonal[j]],
+                [upper[k], lower[j]],
+                [rhs[k], rhs[j]],
+            )
+        } else {
+            ([diagonal[k], 1.0], [upper[k], 0.0], [rhs[k], 0.0])
+        };
+        let (values, ratios, usable) = chains.eliminate(inward, diagonal, outward, linked, b);
+        healthy &= usable;
+        (rhs[k], scratch[k]) = (values[0], ratios[0]);
+        if paired {
+            (rhs[j], scratch[j]) = (values[1], ratios[1]);
+        }
+        if k % RESCALE == RESCALE - 1 {
+            chains.rescale();
         }
     }
     let from_above = if m > 0 { lower[m] } else { 0.0 };
     let from_below = if pairs > 0 { upper[m] } else { 0.0 };
-    let pivot = diagonal[m] - from_above * above.0 - from_below * below.0;
+    let (above, below) = (m.checked_sub(1), (pairs > 0).then_some(m + 1));
+    let (above_ratio, above_value) = above.map_or((0.0, 0.0), |i| (scratch[i], rhs[i]));
+    let (below_ratio, below_value) = below.map_or((0.0, 0.0), |i| (scratch[i], rhs[i]));
+    let pivot = diagonal[m] - from_above * above_ratio - from_below * below_ratio;
     healthy &= usable(
         pivot,
         from_above.abs() + diagonal[m].abs() + from_below.abs(),
@@ -74,17 +99,93 @@ pub fn solve_tridiagonal(
     if !healthy {
         return Err(first_singular_row(lower, diagonal, upper));
     }
-    rhs[m] = (rhs[m] - from_above * above.1 - from_below * below.1) / pivot;
-    // Back-substitution outwards from the middle, both halves together.
-    for k in 1..=m {
-        let i = m - k;
-        rhs[i] -= scratch[i] * rhs[i + 1];
-        if k <= pairs {
-            let j = m + k;
-            rhs[j] -= scratch[j] * rhs[j - 1];
-        }
+    let middle = (rhs[m] - from_above * above_value - from_below * below_value) / pivot;
+    rhs[m] = middle;
+    // Back-substitution outwards from the middle, both halves together, each carrying
+    // its last value in a register (through memory, the store-to-load forwarding
+    // would sit on the chain).
+    let (mut inner_above, mut inner_below) = (middle, middle);
+    for k in 1..=pairs {
+        let (i, j) = (m - k, m + k);
+        inner_above = rhs[i] - scratch[i] * inner_above;
+        rhs[i] = inner_above;
+        inner_below = rhs[j] - scratch[j] * inner_below;
+        rhs[j] = inner_below;
+    }
+    if m > pairs {
+        rhs[0] -= scratch[0] * inner_above;
     }
     Ok(())
+}
+
+/// Rows between exact rescalings of the leading minors: two rows of pivots as small as
+/// 1e-100 or as large as 1e100 (strand systems' pivots span a few decades around 1e-4) stay
+/// inside the exponent range; rescaling more often costs no measurable time.
+const RESCALE: usize = 2;
+
+/// The two elimination chains' states, lane by lane (0 from above, 1 from below):
+/// the last two leading minors and the last scaled right-hand side, each lane in its
+/// own power-of-two scale. Both lanes go through the same operations, which the
+/// compiler packs into one vector instruction each.
+#[derive(Clone, Copy, Debug)]
+struct Chains {
+    previous: [f64; 2],
+    before: [f64; 2],
+    value: [f64; 2],
+}
+
+impl Default for Chains {
+    fn default() -> Self {
+        Self {
+            previous: [1.0; 2],
+            before: [0.0; 2],
+            value: [0.0; 2],
+        }
+    }
+}
+
+impl Chains {
+    /// Eliminate one row per lane (`inward` coupling, `diagonal`, `outward` coupling,
+    /// `linked` = inward × the previous row's outward, right-hand side `b`): the
+    /// eliminated values, the outward couplings over the pivots, and whether both
+    /// pivots are usable.
+    #[inline(always)]
+    fn eliminate(
+        &mut self,
+        inward: [f64; 2],
+        diagonal: [f64; 2],
+        outward: [f64; 2],
+        linked: [f64; 2],
+        b: [f64; 2],
+    ) -> ([f64; 2], [f64; 2], bool) {
+        let (mut values, mut ratios, mut usable) = ([0.0; 2], [0.0; 2], [false; 2]);
+        for l in 0..2 {
+            let minor = diagonal[l] * self.previous[l] - linked[l] * self.before[l];
+            let value = self.previous[l] * b[l] - inward[l] * self.value[l];
+            let reciprocal = 1.0 / minor;
+            let inverse_pivot = self.previous[l] * reciprocal;
+            values[l] = value * reciprocal;
+            ratios[l] = outward[l] * inverse_pivot;
+            (self.before[l], self.previous[l], self.value[l]) = (self.previous[l], minor, value);
+            // `usable(1 / inverse_pivot, row scale)` without the division.
+            let scale = inward[l].abs() + diagonal[l].abs() + outward[l].abs();
+            usable[l] = (inverse_pivot != 0.0) & (inverse_pivot.abs() * (1e-14 * scale) < 1.0);
+        }
+        (values, ratios, usable[0] & usable[1])
+    }
+
+    /// Multiply each lane by the power of two that brings its latest minor to [1, 2):
+    /// exact, so every ratio is unchanged.
+    #[inline(always)]
+    fn rescale(&mut self) {
+        for l in 0..2 {
+            let exponent = ((self.previous[l].to_bits() >> 52) & 0x7ff).clamp(1, 2045);
+            let factor = f64::from_bits((2046 - exponent) << 52);
+            self.previous[l] *= factor;
+            self.before[l] *= factor;
+            self.value[l] *= factor;
+        }
+    }
 }
 
 /// Whether a pivot is usable: finite and not negligible against its row.
@@ -172,6 +273,44 @@ impl TridiagonalFactor {
     /// Solve `A X = B` in place for `k` right-hand sides stored row by row:
     /// `columns[i * k + c]` is row i of column c.
     pub fn solve_many(&self, columns: &mut [f64], k: usize) {
+        match k {
+            1 => self.solve_rows::<1>(columns),
+            2 => self.solve_rows::<2>(columns),
+            _ => self.solve_rows_any(columns, k),
+        }
+    }
+
+    /// [`TridiagonalFactor::solve_many`] for `K` columns known at compile time: the
+    /// row just solved stays in registers for the next (read back from memory, the
+    /// store-to-load forwarding would sit on the chain of rows).
+    fn solve_rows<const K: usize>(&self, columns: &mut [f64]) {
+        let n = self.len();
+        if n == 0 {
+            return;
+        }
+        let rows = columns[..n * K].as_chunks_mut::<K>().0;
+        let mut previous = [0.0; K];
+        for (i, row) in rows.iter_mut().enumerate() {
+            let (l, inv) = (
+                if i > 0 { self.lower[i] } else { 0.0 },
+                self.inverse_pivot[i],
+            );
+            for c in 0..K {
+                previous[c] = (row[c] - l * previous[c]) * inv;
+                row[c] = previous[c];
+            }
+        }
+        let mut following = [0.0; K];
+        for (i, row) in rows.iter_mut().enumerate().rev() {
+            let ratio = if i + 1 < n { self.ratio[i] } else { 0.0 };
+            for c in 0..K {
+                following[c] = row[c] - ratio * following[c];
+                row[c] = following[c];
+            }
+        }
+    }
+
+    fn solve_rows_any(&self, columns: &mut [f64], k: usize) {
         let n = self.len();
         if n == 0 || k == 0 {
             return;
@@ -331,6 +470,38 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn long_systems_of_tiny_or_huge_pivots_neither_overflow_nor_underflow() {
+        // Leading minors of 5000 rows with pivots near 1e±100 leave the exponent range
+        // within four rows: the chains' rescaling must keep them in it.
+        let mut rng = StdRng::seed_from_u64(11);
+        for magnitude in [1e-100, 1e100] {
+            let n = 5000;
+            let (lower, diagonal, upper) = strand_like(n, 0.0, &mut rng);
+            let scaled = |v: &[f64]| v.iter().map(|x| x * magnitude).collect::<Vec<_>>();
+            let (lower, diagonal, upper) = (scaled(&lower), scaled(&diagonal), scaled(&upper));
+            let rhs: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let mut x = rhs.clone();
+            solve_tridiagonal(&lower, &diagonal, &upper, &mut x, &mut vec![0.0; n]).unwrap();
+            // The residual row by row, relative to the row's terms.
+            for i in 0..n {
+                let mut terms = [diagonal[i] * x[i], 0.0, 0.0];
+                if i > 0 {
+                    terms[1] = lower[i] * x[i - 1];
+                }
+                if i + 1 < n {
+                    terms[2] = upper[i] * x[i + 1];
+                }
+                let size: f64 = terms.iter().map(|t| t.abs()).sum::<f64>() + rhs[i].abs();
+                let residual = (terms.iter().sum::<f64>() - rhs[i]).abs();
+                assert!(
+                    x[i].is_finite() && residual <= 1e-12 * size,
+                    "magnitude {magnitude:e}, row {i}: residual {residual:e} of {size:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn solves_an_unsymmetric_system() {
         let lower = [0.0, -1.0, 0.5, 2.0];
         let diagonal = [4.0, 5.0, 6.0, 7.0];
@@ -351,22 +522,26 @@ pub(crate) mod tests {
         let (lower, diagonal, upper) = strand_like(n, 2.0, &mut rng);
         let mut factor = TridiagonalFactor::default();
         factor.factor(&lower, &diagonal, &upper).unwrap();
-        let k = 5;
-        let columns: Vec<Vec<f64>> = (0..k)
-            .map(|_| (0..n).map(|_| rng.random_range(-1.0..1.0)).collect())
-            .collect();
-        let mut together = vec![0.0; n * k];
-        for (c, column) in columns.iter().enumerate() {
-            for i in 0..n {
-                together[i * k + c] = column[i];
+        // One and two columns take the register-carried path, more the general one.
+        for k in [1, 2, 5] {
+            let columns: Vec<Vec<f64>> = (0..k)
+                .map(|_| (0..n).map(|_| rng.random_range(-1.0..1.0)).collect())
+                .collect();
+            let mut together = vec![0.0; n * k];
+            for (c, column) in columns.iter().enumerate() {
+                for i in 0..n {
+                    together[i * k + c] = column[i];
+                }
             }
-        }
-        factor.solve_many(&mut together, k);
-        for (c, column) in columns.iter().enumerate() {
-            let mut alone = column.clone();
-            solve_tridiagonal(&lower, &diagonal, &upper, &mut alone, &mut vec![0.0; n]).unwrap();
-            for i in 0..n {
-                assert!((together[i * k + c] - alone[i]).abs() <= 1e-12 * alone[i].abs().max(1e-3));
+            factor.solve_many(&mut together, k);
+            for (c, column) in columns.iter().enumerate() {
+                let mut alone = column.clone();
+                solve_tridiagonal(&lower, &diagonal, &upper, &mut alone, &mut vec![0.0; n])
+                    .unwrap();
+                for i in 0..n {
+                    let tolerance = 1e-12 * alone[i].abs().max(1e-3);
+                    assert!((together[i * k + c] - alone[i]).abs() <= tolerance, "k {k}");
+                }
             }
         }
     }
