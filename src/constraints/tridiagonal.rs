@@ -223,11 +223,18 @@ fn first_singular_row(lower: &[f64], diagonal: &[f64], upper: &[f64]) -> Singula
 /// sides with multiplications only. Solving the right-hand sides together, row by row
 /// ([`TridiagonalFactor::solve_many`]), replaces Thomas' latency-bound chain of
 /// divisions with independent multiply-adds across the columns.
+///
+/// Eliminated from both ends to the middle row `n / 2`, like [`solve_tridiagonal`]:
+/// a solve runs two chains of half the length side by side. Row `i` stores its inverse
+/// pivot, its inward coupling over the pivot (towards the end it was eliminated from)
+/// and its outward one (towards the middle); the middle row has two inward couplings.
 #[derive(Clone, Debug, Default)]
 pub struct TridiagonalFactor {
-    lower: Vec<f64>,
     inverse_pivot: Vec<f64>,
+    inward: Vec<f64>,
     ratio: Vec<f64>,
+    /// The middle row's coupling to the row below it, over its pivot.
+    middle_below: f64,
 }
 
 impl TridiagonalFactor {
@@ -239,19 +246,54 @@ impl TridiagonalFactor {
         upper: &[f64],
     ) -> Result<(), SingularPivot> {
         let n = diagonal.len();
-        for buffer in [&mut self.lower, &mut self.inverse_pivot, &mut self.ratio] {
+        for buffer in [&mut self.inverse_pivot, &mut self.inward, &mut self.ratio] {
             buffer.clear();
             buffer.resize(n, 0.0);
         }
-        for i in 0..n {
-            let coupling = if i > 0 { lower[i] } else { 0.0 };
-            let outer = if i + 1 < n { upper[i] } else { 0.0 };
-            let pivot = diagonal[i] - coupling * if i > 0 { self.ratio[i - 1] } else { 0.0 };
-            check_pivot(pivot, coupling.abs() + diagonal[i].abs() + outer.abs(), i)?;
-            self.lower[i] = coupling;
-            self.inverse_pivot[i] = 1.0 / pivot;
-            self.ratio[i] = outer / pivot;
+        self.middle_below = 0.0;
+        if n == 0 {
+            return Ok(());
         }
+        let (last, m) = (n - 1, n / 2);
+        // Row `row`, coupled to the row it is eliminated after by `inward` (that row's
+        // ratio `previous`) and to the next one towards the middle by `outward`.
+        let mut eliminate = |row: usize, inward: f64, outward: f64, previous: f64| {
+            let pivot = diagonal[row] - inward * previous;
+            check_pivot(
+                pivot,
+                inward.abs() + diagonal[row].abs() + outward.abs(),
+                row,
+            )?;
+            let inverse = 1.0 / pivot;
+            self.inverse_pivot[row] = inverse;
+            self.inward[row] = inward * inverse;
+            self.ratio[row] = outward * inverse;
+            Ok::<f64, SingularPivot>(outward * inverse)
+        };
+        let mut previous = 0.0;
+        for k in 0..m {
+            let inward = if k > 0 { lower[k] } else { 0.0 };
+            previous = eliminate(k, inward, upper[k], previous)?;
+        }
+        let above = previous;
+        previous = 0.0;
+        for j in (m + 1..n).rev() {
+            let inward = if j < last { upper[j] } else { 0.0 };
+            previous = eliminate(j, inward, lower[j], previous)?;
+        }
+        let below = previous;
+        let from_above = if m > 0 { lower[m] } else { 0.0 };
+        let from_below = if m < last { upper[m] } else { 0.0 };
+        let pivot = diagonal[m] - from_above * above - from_below * below;
+        check_pivot(
+            pivot,
+            from_above.abs() + diagonal[m].abs() + from_below.abs(),
+            m,
+        )?;
+        let inverse = 1.0 / pivot;
+        self.inverse_pivot[m] = inverse;
+        self.inward[m] = from_above * inverse;
+        self.middle_below = from_below * inverse;
         Ok(())
     }
 
@@ -274,63 +316,96 @@ impl TridiagonalFactor {
     /// `columns[i * k + c]` is row i of column c.
     pub fn solve_many(&self, columns: &mut [f64], k: usize) {
         match k {
+            0 => {}
             1 => self.solve_rows::<1>(columns),
             2 => self.solve_rows::<2>(columns),
-            _ => self.solve_rows_any(columns, k),
+            _ => {
+                for c in 0..k {
+                    self.solve_column(columns, k, c);
+                }
+            }
         }
     }
 
-    /// [`TridiagonalFactor::solve_many`] for `K` columns known at compile time: the
-    /// row just solved stays in registers for the next (read back from memory, the
-    /// store-to-load forwarding would sit on the chain of rows).
+    /// [`TridiagonalFactor::solve_many`] for `K` columns known at compile time, both
+    /// halves' chains together; the row just solved stays in registers for the next
+    /// (read back from memory, the store-to-load forwarding would sit on the chain).
     fn solve_rows<const K: usize>(&self, columns: &mut [f64]) {
         let n = self.len();
         if n == 0 {
             return;
         }
+        let (last, m) = (n - 1, n / 2);
         let rows = columns[..n * K].as_chunks_mut::<K>().0;
-        let mut previous = [0.0; K];
-        for (i, row) in rows.iter_mut().enumerate() {
-            let (l, inv) = (
-                if i > 0 { self.lower[i] } else { 0.0 },
-                self.inverse_pivot[i],
-            );
+        let (mut above, mut below) = ([0.0; K], [0.0; K]);
+        for k in 0..m {
+            let (inverse, inward) = (self.inverse_pivot[k], self.inward[k]);
             for c in 0..K {
-                previous[c] = (row[c] - l * previous[c]) * inv;
-                row[c] = previous[c];
+                above[c] = rows[k][c] * inverse - inward * above[c];
+                rows[k][c] = above[c];
+            }
+            let j = last - k;
+            if j > m {
+                let (inverse, inward) = (self.inverse_pivot[j], self.inward[j]);
+                for c in 0..K {
+                    below[c] = rows[j][c] * inverse - inward * below[c];
+                    rows[j][c] = below[c];
+                }
             }
         }
-        let mut following = [0.0; K];
-        for (i, row) in rows.iter_mut().enumerate().rev() {
-            let ratio = if i + 1 < n { self.ratio[i] } else { 0.0 };
+        let (inverse, from_above) = (self.inverse_pivot[m], self.inward[m]);
+        for c in 0..K {
+            let value = rows[m][c] * inverse - from_above * above[c] - self.middle_below * below[c];
+            rows[m][c] = value;
+            (above[c], below[c]) = (value, value);
+        }
+        for k in 1..=m {
+            let i = m - k;
+            let ratio = self.ratio[i];
             for c in 0..K {
-                following[c] = row[c] - ratio * following[c];
-                row[c] = following[c];
+                above[c] = rows[i][c] - ratio * above[c];
+                rows[i][c] = above[c];
+            }
+            let j = m + k;
+            if j < n {
+                let ratio = self.ratio[j];
+                for c in 0..K {
+                    below[c] = rows[j][c] - ratio * below[c];
+                    rows[j][c] = below[c];
+                }
             }
         }
     }
 
-    fn solve_rows_any(&self, columns: &mut [f64], k: usize) {
+    /// Column `c` of `k` stored row by row, alone.
+    fn solve_column(&self, columns: &mut [f64], k: usize, c: usize) {
         let n = self.len();
-        if n == 0 || k == 0 {
+        if n == 0 {
             return;
         }
-        for x in &mut columns[..k] {
-            *x *= self.inverse_pivot[0];
+        let (last, m) = (n - 1, n / 2);
+        let at = |i: usize| i * k + c;
+        let (mut above, mut below) = (0.0, 0.0);
+        for i in 0..m {
+            above = columns[at(i)] * self.inverse_pivot[i] - self.inward[i] * above;
+            columns[at(i)] = above;
         }
-        for i in 1..n {
-            let (done, row) = columns[(i - 1) * k..(i + 1) * k].split_at_mut(k);
-            let (l, inv) = (self.lower[i], self.inverse_pivot[i]);
-            for (x, previous) in row.iter_mut().zip(done.iter()) {
-                *x = (*x - l * *previous) * inv;
-            }
+        for j in (m + 1..=last).rev() {
+            below = columns[at(j)] * self.inverse_pivot[j] - self.inward[j] * below;
+            columns[at(j)] = below;
         }
-        for i in (0..n - 1).rev() {
-            let (row, done) = columns[i * k..(i + 2) * k].split_at_mut(k);
-            let ratio = self.ratio[i];
-            for (x, following) in row.iter_mut().zip(done.iter()) {
-                *x -= ratio * *following;
-            }
+        let middle = columns[at(m)] * self.inverse_pivot[m]
+            - self.inward[m] * above
+            - self.middle_below * below;
+        columns[at(m)] = middle;
+        (above, below) = (middle, middle);
+        for i in (0..m).rev() {
+            above = columns[at(i)] - self.ratio[i] * above;
+            columns[at(i)] = above;
+        }
+        for j in m + 1..n {
+            below = columns[at(j)] - self.ratio[j] * below;
+            columns[at(j)] = below;
         }
     }
 }

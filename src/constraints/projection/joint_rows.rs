@@ -177,16 +177,19 @@ fn link_responses<W: Walk>(c: usize, link: usize, walk: Option<W>, s: &mut Joint
     let r = &mut s.particle_responses[particle_offset..particle_offset + 2 * particles];
     r.fill(DVec2::ZERO);
     let (r_n, r_t) = r.split_at_mut(particles);
+    // Starts first, then ends: along a chain an edge's end is the next one's start,
+    // and in one loop each update would wait on the last one's store.
     for k in 0..m {
-        let (a, b) = s.ends[first_edge + k];
-        let (a, b) = (a as usize, b as usize);
-        let d = 2.0 * s.edge[first_edge + k];
-        let (y_n, y_t) = (y[2 * k], y[2 * k + 1]);
-        let (w_a, w_b) = (s.inverse_mass[a], s.inverse_mass[b]);
-        r_n[a - first] += w_a * y_n * d;
-        r_n[b - first] -= w_b * y_n * d;
-        r_t[a - first] += w_a * y_t * d;
-        r_t[b - first] -= w_b * y_t * d;
+        let a = s.ends[first_edge + k].0 as usize;
+        let d = 2.0 * s.inverse_mass[a] * s.edge[first_edge + k];
+        r_n[a - first] += y[2 * k] * d;
+        r_t[a - first] += y[2 * k + 1] * d;
+    }
+    for k in 0..m {
+        let b = s.ends[first_edge + k].1 as usize;
+        let d = 2.0 * s.inverse_mass[b] * s.edge[first_edge + k];
+        r_n[b - first] -= y[2 * k] * d;
+        r_t[b - first] -= y[2 * k + 1] * d;
     }
     for &(j, coefficient) in &row.entries[..row.count as usize] {
         if in_part(j) {
