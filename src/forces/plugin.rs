@@ -29,6 +29,7 @@ pub fn accumulate_forces(
     config: Res<StrandsConfig>,
     topology: Res<Topology>,
     mut state: ResMut<ParticleState>,
+    mut shares: Local<(Option<(u64, usize)>, bending::BendingShares)>,
 ) {
     let ParticleState {
         position,
@@ -44,7 +45,14 @@ pub fn accumulate_forces(
     springs::add_stretch_springs(&topology.edges, position, velocity, force);
     // The quadratic model is integrated implicitly, in the Predict stage.
     if config.bending == BendingModel::Angle {
-        bending::add_bending(&topology.bends, position, velocity, force);
+        // The shares depend only on the topology and the thread count.
+        let key = Some((topology.version, config.worker_threads()));
+        let (cut_for, shares) = &mut *shares;
+        if *cut_for != key || shares.is_empty() {
+            shares.cut(&topology.bends, force.len(), config.worker_threads());
+            *cut_for = key;
+        }
+        bending::add_bending_shared(&topology.bends, position, velocity, force, shares);
     }
 }
 
