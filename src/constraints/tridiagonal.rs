@@ -26,8 +26,8 @@ pub struct SingularPivot {
 /// l_k u_{k−1} q_{k−2}` (pivot `q_k / q_{k−1}`) and the scaled right-hand side
 /// `Y_k = q_{k−1} b_k − l_k Y_{k−1}` (eliminated value `Y_k / q_k`): multiplications
 /// only, with one reciprocal per row that nothing later in the chain waits for. The
-/// minors are rescaled by powers of two every few rows, exactly, so they never
-/// overflow or underflow.
+/// minors are rescaled by powers of two every two rows, exactly, so they neither
+/// overflow nor underflow.
 pub fn solve_tridiagonal(
     lower: &[f64],
     diagonal: &[f64],
@@ -118,15 +118,16 @@ pub fn solve_tridiagonal(
     Ok(())
 }
 
-/// Rows between exact rescalings of the leading minors: two rows of pivots as small as
-/// 1e-100 or as large as 1e100 (strand systems' pivots span a few decades around 1e-4) stay
-/// inside the exponent range; rescaling more often costs no measurable time.
+/// Rows between exact rescalings of the leading minors: two rows of pivots as small
+/// as 1e-100 or as large as 1e100 stay inside the exponent range (strand systems'
+/// pivots span a few decades around 1e-4); rescaling this often costs no measurable
+/// time.
 const RESCALE: usize = 2;
 
 /// The two elimination chains' states, lane by lane (0 from above, 1 from below):
 /// the last two leading minors and the last scaled right-hand side, each lane in its
-/// own power-of-two scale. Both lanes go through the same operations, which the
-/// compiler packs into one vector instruction each.
+/// own power-of-two scale. Both lanes go through the same operations, so the compiler
+/// can pack them into vector instructions.
 #[derive(Clone, Copy, Debug)]
 struct Chains {
     previous: [f64; 2],
