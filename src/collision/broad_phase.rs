@@ -4,7 +4,8 @@
 //! the margin) is entered into a uniform grid, hashed into a table and stored by
 //! counting sort in reused buffers; each point's swept segment then queries the cells
 //! it covers. Cost grows near-linearly with the number of edges in a pile. Brute force
-//! (every pair) stays available for testing.
+//! (every pair) stays available for testing. Large builds and queries are shared
+//! between threads, with the same grid and pairs on any count.
 
 use bevy::math::DVec2;
 use bevy::prelude::Reflect;
@@ -110,15 +111,146 @@ fn hash(ix: i64, iy: i64, mask: usize) -> usize {
     ((ix.wrapping_mul(73_856_093) ^ iy.wrapping_mul(19_349_663)) as u64 as usize) & mask
 }
 
+/// Below this many edges the grid is built on one thread.
+const PARALLEL_BUILD: usize = 16_384;
+
+/// Edges whose box sizes are summed together before the blocks' sums are added, in
+/// order: the cell size is the same on any thread count.
+const EXTENT_BLOCK: usize = 4096;
+
+/// A placeholder box, overwritten before it is read.
+const EMPTY: Aabb = Aabb {
+    min: DVec2::ZERO,
+    max: DVec2::ZERO,
+};
+
+/// The cells of a box at `inverse_cell` cells per unit, or `None` when it is better
+/// tested against everything than entered in the grid.
+fn cells_of(b: &Aabb, inverse_cell: f64) -> Option<CellRange> {
+    let f = |v: f64| floor_to_i64(v * inverse_cell);
+    let (x0, y0, x1, y1) = (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y));
+    let oversized = !b.min.is_finite()
+        || !b.max.is_finite()
+        || x1
+            .saturating_sub(x0)
+            .saturating_add(1)
+            .saturating_mul(y1.saturating_sub(y0).saturating_add(1))
+            > MAX_CELLS_PER_EDGE;
+    (!oversized).then_some((x0, y0, x1, y1))
+}
+
+/// The swept boxes of `edges[start..]` into `boxes`, and each block of
+/// [`EXTENT_BLOCK`] edges' summed box size to `sum`, in order (`start` a multiple of
+/// the block).
+fn fill_boxes(
+    edges: &[Edge],
+    position: &[DVec2],
+    displacement: Option<&[DVec2]>,
+    margin: f64,
+    start: usize,
+    boxes: &mut [Aabb],
+    sum: &mut dyn FnMut(f64),
+) {
+    for (block, boxes) in boxes.chunks_mut(EXTENT_BLOCK).enumerate() {
+        let mut extent = 0.0;
+        for (k, slot) in boxes.iter_mut().enumerate() {
+            let e = &edges[start + block * EXTENT_BLOCK + k];
+            let (a, b) = (e.a as usize, e.b as usize);
+            let (da, db) = displacement.map_or((DVec2::ZERO, DVec2::ZERO), |d| (d[a], d[b]));
+            let b = Aabb::swept(
+                &[position[a], position[b], position[a] + da, position[b] + db],
+                margin,
+            );
+            let size = b.max - b.min;
+            if size.is_finite() {
+                extent += size.max_element();
+            }
+            *slot = b;
+        }
+        sum(extent);
+    }
+}
+
+/// The cells of `boxes[start..]` into `cells`, the oversized ones' indices appended to
+/// `oversized`: the range holding every cell.
+fn fill_cells(
+    boxes: &[Aabb],
+    inverse_cell: f64,
+    start: usize,
+    cells: &mut [Option<CellRange>],
+    oversized: &mut Vec<u32>,
+) -> Option<CellRange> {
+    let mut bounds: Option<CellRange> = None;
+    for (k, slot) in cells.iter_mut().enumerate() {
+        *slot = cells_of(&boxes[start + k], inverse_cell);
+        match (*slot, &mut bounds) {
+            (None, _) => oversized.push((start + k) as u32),
+            (Some(c), None) => bounds = Some(c),
+            (Some(c), Some(b)) => *b = union(*b, c),
+        }
+    }
+    bounds
+}
+
+/// The smallest cell range holding both.
+fn union(a: CellRange, b: CellRange) -> CellRange {
+    (a.0.min(b.0), a.1.min(b.1), a.2.max(b.2), a.3.max(b.3))
+}
+
+/// `items` cut before each of `cuts` after the first (ascending, the first 0, the last
+/// `items.len()`): one slice per run.
+fn split_at_cuts<'a, T>(mut items: &'a mut [T], cuts: &[usize]) -> Vec<&'a mut [T]> {
+    let mut runs = Vec::with_capacity(cuts.len().saturating_sub(1));
+    for w in cuts.windows(2) {
+        let (run, rest) = std::mem::take(&mut items).split_at_mut(w[1] - w[0]);
+        runs.push(run);
+        items = rest;
+    }
+    runs
+}
+
+/// `work(i, part)` for every part, the first on this thread and the others on scoped
+/// threads; the results in part order.
+fn run_each<P: Send, R: Send>(parts: Vec<P>, work: impl Fn(usize, P) -> R + Sync) -> Vec<R> {
+    if parts.len() <= 1 {
+        return parts.into_iter().map(|p| work(0, p)).collect();
+    }
+    let work = &work;
+    std::thread::scope(|scope| {
+        let mut parts = parts.into_iter();
+        let first = parts.next().expect("more than one part");
+        let handles: Vec<_> = (parts.enumerate())
+            .map(|(i, p)| scope.spawn(move || work(i + 1, p)))
+            .collect();
+        let mut results = vec![work(0, first)];
+        for h in handles {
+            results.push(h.join().expect("a broad-phase thread panicked"));
+        }
+        results
+    })
+}
+
+/// `work(first index, run)` over `threads` contiguous runs of `items` that start at
+/// multiples of `align`; the results in run order.
+fn in_runs<T: Send, R: Send>(
+    items: &mut [T],
+    threads: usize,
+    align: usize,
+    work: impl Fn(usize, &mut [T]) -> R + Sync,
+) -> Vec<R> {
+    let blocks = items.len().div_ceil(align);
+    let threads = threads.clamp(1, blocks.max(1));
+    let cuts: Vec<usize> = (0..=threads)
+        .map(|t| (blocks * t / threads * align).min(items.len()))
+        .collect();
+    let parts = split_at_cuts(items, &cuts);
+    run_each(parts, |t, run| work(cuts[t], run))
+}
+
 /// A grid of at most this many cells per edge is indexed directly, not hashed.
 const DENSE_CELLS_PER_EDGE: i64 = 8;
 
 impl BroadPhase {
-    fn cell_range(&self, b: &Aabb) -> CellRange {
-        let f = |v: f64| floor_to_i64(v * self.inverse_cell);
-        (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y))
-    }
-
     /// The bucket of a cell (inside the dense grid, when there is one).
     fn bucket(&self, ix: i64, iy: i64) -> usize {
         match self.dense {
@@ -130,81 +262,101 @@ impl BroadPhase {
     /// The cells of a box, or `None` when it is better tested against everything than
     /// entered in the grid.
     fn cells(&self, b: &Aabb) -> Option<CellRange> {
-        let range @ (x0, y0, x1, y1) = self.cell_range(b);
-        let oversized = !b.min.is_finite()
-            || !b.max.is_finite()
-            || x1
-                .saturating_sub(x0)
-                .saturating_add(1)
-                .saturating_mul(y1.saturating_sub(y0).saturating_add(1))
-                > MAX_CELLS_PER_EDGE;
-        (!oversized).then_some(range)
+        cells_of(b, self.inverse_cell)
     }
 
     /// Build the grid over every edge's swept box: positions `x`, end positions
-    /// `x + d` (`None`: not moving), inflated by `margin`.
+    /// `x + d` (`None`: not moving), inflated by `margin`. With `threads` above one and
+    /// at least [`PARALLEL_BUILD`] edges, the boxes, their cells and (in a dense grid)
+    /// the counting sort are shared between threads: the boxes and cells by contiguous
+    /// runs of edges, the sort by bands of grid rows, each thread entering every edge's
+    /// cells of its own band in edge order. The grid is the same whatever the count.
     pub fn build(
         &mut self,
         edges: &[Edge],
         position: &[DVec2],
         displacement: Option<&[DVec2]>,
         margin: f64,
+        threads: usize,
     ) {
-        self.build_boxes(edges.iter(), position, displacement, margin);
-    }
-
-    fn build_boxes<'e>(
-        &mut self,
-        edges: impl ExactSizeIterator<Item = &'e Edge>,
-        position: &[DVec2],
-        displacement: Option<&[DVec2]>,
-        margin: f64,
-    ) {
+        let count = edges.len();
+        let threads = if count >= PARALLEL_BUILD {
+            threads.max(1)
+        } else {
+            1
+        };
+        // The boxes, and their sizes summed block by block (the same sum on any count).
         self.edge_boxes.clear();
+        self.edge_boxes.resize(count, EMPTY);
         let mut extent = 0.0;
-        let count = edges.len().max(1);
-        for e in edges {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let (da, db) = displacement.map_or((DVec2::ZERO, DVec2::ZERO), |d| (d[a], d[b]));
-            let b = Aabb::swept(
-                &[position[a], position[b], position[a] + da, position[b] + db],
-                margin,
+        let fill = |start: usize, boxes: &mut [Aabb], sum: &mut dyn FnMut(f64)| {
+            fill_boxes(edges, position, displacement, margin, start, boxes, sum);
+        };
+        if threads == 1 {
+            fill(0, &mut self.edge_boxes, &mut |s| extent += s);
+        } else {
+            let sums = in_runs(
+                &mut self.edge_boxes,
+                threads,
+                EXTENT_BLOCK,
+                |start, boxes| {
+                    let mut sums = Vec::with_capacity(boxes.len().div_ceil(EXTENT_BLOCK));
+                    fill(start, boxes, &mut |s| sums.push(s));
+                    sums
+                },
             );
-            let size = b.max - b.min;
-            if size.is_finite() {
-                extent += size.max_element();
-            }
-            self.edge_boxes.push(b);
+            sums.into_iter().flatten().for_each(|s| extent += s);
         }
         // A cell about the size of a typical edge's box.
-        self.inverse_cell = 1.0 / (extent / count as f64).max(1e-9);
-        self.oversized.clear();
+        self.inverse_cell = 1.0 / (extent / count.max(1) as f64).max(1e-9);
+        let inverse_cell = self.inverse_cell;
         self.edge_cells.clear();
-        let mut bounds: Option<CellRange> = None;
-        for k in 0..self.edge_boxes.len() {
-            let cells = self.cells(&self.edge_boxes[k]);
-            self.edge_cells.push(cells);
-            match (cells, &mut bounds) {
-                (None, _) => self.oversized.push(k as u32),
-                (Some(c), None) => bounds = Some(c),
-                (Some(c), Some(b)) => {
-                    *b = (b.0.min(c.0), b.1.min(c.1), b.2.max(c.2), b.3.max(c.3));
-                }
+        self.edge_cells.resize(count, None);
+        self.oversized.clear();
+        let boxes = &self.edge_boxes;
+        let bounds = if threads == 1 {
+            fill_cells(
+                boxes,
+                inverse_cell,
+                0,
+                &mut self.edge_cells,
+                &mut self.oversized,
+            )
+        } else {
+            let runs = in_runs(&mut self.edge_cells, threads, 1, |start, cells| {
+                let mut oversized = Vec::new();
+                let bounds = fill_cells(boxes, inverse_cell, start, cells, &mut oversized);
+                (bounds, oversized)
+            });
+            let mut bounds: Option<CellRange> = None;
+            for (b, oversized) in runs {
+                self.oversized.extend_from_slice(&oversized);
+                bounds = match (bounds, b) {
+                    (Some(a), Some(b)) => Some(union(a, b)),
+                    (a, b) => a.or(b),
+                };
             }
-        }
+            bounds
+        };
         self.dense = bounds.filter(|&(x0, y0, x1, y1)| {
             let cells = (x1 - x0 + 1).saturating_mul(y1 - y0 + 1);
-            cells <= DENSE_CELLS_PER_EDGE.saturating_mul(count as i64)
+            cells <= DENSE_CELLS_PER_EDGE.saturating_mul(count.max(1) as i64)
         });
         let table = match self.dense {
             Some((x0, y0, x1, y1)) => ((x1 - x0 + 1) * (y1 - y0 + 1)) as usize,
-            None => (2 * count).next_power_of_two(),
+            None => (2 * count.max(1)).next_power_of_two(),
         };
         self.mask = table.next_power_of_two() - 1;
+        match self.dense {
+            Some(grid) if threads > 1 => self.sort_in_bands(grid, table, threads),
+            _ => self.sort_entries(table),
+        }
+    }
+
+    /// Count, prefix-sum, fill: a counting sort of (bucket, edge) entries.
+    fn sort_entries(&mut self, table: usize) {
         self.bucket_start.clear();
         self.bucket_start.resize(table + 1, 0);
-
-        // Count, prefix-sum, fill: a counting sort of (bucket, edge) entries.
         for k in 0..self.edge_boxes.len() {
             let Some((x0, y0, x1, y1)) = self.edge_cells[k] else {
                 continue;
@@ -235,6 +387,77 @@ impl BroadPhase {
                 }
             }
         }
+    }
+
+    /// [`BroadPhase::sort_entries`] for the dense grid `grid`, on `threads` threads:
+    /// each counts, sums and fills the buckets of its own band of grid rows, so each
+    /// writes its own runs of the arrays and the result is the one-thread one.
+    fn sort_in_bands(&mut self, grid: CellRange, table: usize, threads: usize) {
+        let (x0, y0, x1, y1) = grid;
+        let (width, rows) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+        let threads = threads.min(rows);
+        // Band t: grid rows rows·t/T to rows·(t+1)/T, whose buckets start at first(t).
+        let first_row = |t: usize| rows * t / threads;
+        let bands: Vec<usize> = (0..=threads).map(|t| first_row(t) * width).collect();
+        let cells = &self.edge_cells;
+        // Every edge's cells in band t, in edge order: (bucket, edge).
+        let enter = |t: usize, visit: &mut dyn FnMut(usize, u32)| {
+            let (from, to) = (y0 + first_row(t) as i64, y0 + first_row(t + 1) as i64);
+            for (k, c) in cells.iter().enumerate() {
+                let Some((cx0, cy0, cx1, cy1)) = *c else {
+                    continue;
+                };
+                for iy in cy0.max(from)..=cy1.min(to - 1) {
+                    let row = (iy - y0) as usize * width;
+                    for ix in cx0..=cx1 {
+                        visit(row + (ix - x0) as usize, k as u32);
+                    }
+                }
+            }
+        };
+        // Counts into bucket_start[b + 1], then each band's running sums from 0.
+        self.bucket_start.clear();
+        self.bucket_start.resize(table + 1, 0);
+        let parts = split_at_cuts(&mut self.bucket_start[1..], &bands);
+        let totals = run_each(parts, |t, counts| {
+            enter(t, &mut |bucket, _| counts[bucket - bands[t]] += 1);
+            let mut sum = 0;
+            for c in counts.iter_mut() {
+                sum += *c;
+                *c = sum;
+            }
+            sum
+        });
+        // Each band's sums moved up by the bands' before it.
+        let mut offsets = Vec::with_capacity(threads);
+        let mut total = 0;
+        for t in totals {
+            offsets.push(total);
+            total += t;
+        }
+        let parts = split_at_cuts(&mut self.bucket_start[1..], &bands);
+        run_each(parts, |t, sums| {
+            sums.iter_mut().for_each(|s| *s += offsets[t])
+        });
+        // Fill: each band with its own cursors into its own run of the entries.
+        self.entries.clear();
+        self.entries.resize(total as usize, 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.bucket_start[..table]);
+        let starts: Vec<usize> = bands
+            .iter()
+            .map(|&b| self.bucket_start[b] as usize)
+            .collect();
+        let cursors = split_at_cuts(&mut self.cursor, &bands);
+        let runs = split_at_cuts(&mut self.entries, &starts);
+        let parts: Vec<_> = cursors.into_iter().zip(runs).collect();
+        run_each(parts, |t, (cursor, run)| {
+            enter(t, &mut |bucket, k| {
+                let slot = &mut cursor[bucket - bands[t]];
+                run[*slot as usize - starts[t]] = k;
+                *slot += 1;
+            });
+        });
     }
 
     /// Visit each edge whose box overlaps `query` (its cells `cells`) once, in a fixed
@@ -538,7 +761,7 @@ mod tests {
             }
             let keep = |p: u32, k: u32| edges[k as usize].a != p && edges[k as usize].b != p;
             let mut broad = BroadPhase::default();
-            broad.build(&edges, &position, Some(&displacement), 0.004);
+            broad.build(&edges, &position, Some(&displacement), 0.004, 1);
             if far {
                 assert!(broad.dense.is_none(), "{strands} strands: hashed");
             }
@@ -580,7 +803,7 @@ mod tests {
         let (position, displacement, edges) = random_scene(&mut rng, 1000);
         assert!(edges.len() >= PARALLEL_QUERIES, "{} edges", edges.len());
         let mut broad = BroadPhase::default();
-        broad.build(&edges, &position, Some(&displacement), 0.004);
+        broad.build(&edges, &position, Some(&displacement), 0.004, 1);
         let test = |j: u32, k: u32| (j + k).is_multiple_of(3);
         let mut listed = Vec::new();
         broad.edge_edge_pairs(BroadPhaseMethod::Grid, test, &mut listed);
@@ -589,5 +812,53 @@ mod tests {
         assert_eq!(one, (listed.len(), listed.first().copied()));
         assert_eq!(broad.count_edge_pairs(2, test), one);
         assert_eq!(broad.count_edge_pairs(3, test), one);
+    }
+
+    #[test]
+    fn building_on_more_threads_gives_the_same_grid() {
+        let mut rng = StdRng::seed_from_u64(9);
+        let (mut position, displacement, edges) = random_scene(&mut rng, 1000);
+        assert!(edges.len() >= PARALLEL_BUILD, "{} edges", edges.len());
+        let grid = |b: &BroadPhase| {
+            (
+                b.inverse_cell.to_bits(),
+                b.dense,
+                b.mask,
+                b.bucket_start.clone(),
+                b.entries.clone(),
+                b.edge_cells.clone(),
+                b.oversized.clone(),
+            )
+        };
+        for spread in [false, true] {
+            if spread {
+                // A few strands far away: the cells no longer fit a dense grid.
+                for p in position.iter_mut().take(200) {
+                    *p *= 1000.0;
+                }
+            }
+            let mut one = BroadPhase::default();
+            one.build(&edges, &position, Some(&displacement), 0.004, 1);
+            assert_eq!(one.dense.is_none(), spread);
+            let mut pairs_one = Vec::new();
+            one.point_edge_pairs(
+                BroadPhaseMethod::Grid,
+                1,
+                &position,
+                &displacement,
+                |p, k| edges[k as usize].a != p && edges[k as usize].b != p,
+                &mut pairs_one,
+            );
+            assert!(pairs_one.len() > 1000);
+            for threads in [2, 3, 5] {
+                let mut many = BroadPhase::default();
+                many.build(&edges, &position, Some(&displacement), 0.004, threads);
+                assert_eq!(
+                    grid(&many),
+                    grid(&one),
+                    "{threads} threads, spread {spread}"
+                );
+            }
+        }
     }
 }

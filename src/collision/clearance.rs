@@ -32,7 +32,7 @@ pub fn overlaps(
     method: BroadPhaseMethod,
     threads: usize,
 ) -> Vec<Overlap> {
-    broad.build(edges, position, None, thickness);
+    broad.build(edges, position, None, thickness, threads);
     let still = vec![DVec2::ZERO; position.len()];
     let keep = |p: u32, k: u32| {
         let e = &edges[k as usize];

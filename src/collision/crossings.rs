@@ -29,7 +29,7 @@ pub fn count_crossings(
     threads: usize,
     pairs: &mut Vec<(u32, u32)>,
 ) -> Crossings {
-    broad.build(edges, position, None, 0.0);
+    broad.build(edges, position, None, 0.0, threads);
     let crossed = |j: u32, k: u32| {
         let (e, f) = (&edges[j as usize], &edges[k as usize]);
         // Walls' and bodies' edges never meet each other (see `Edge::solid`).

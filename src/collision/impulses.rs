@@ -193,6 +193,7 @@ impl Collider<'_> {
             self.position,
             Some(&scratch.displacement),
             self.settings.thickness,
+            self.settings.threads,
         );
         scratch.pairs.clear();
         let (edges, w, solid) = (self.edges, self.inverse_mass, self.solid);
