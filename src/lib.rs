@@ -47,6 +47,7 @@ pub mod guard;
 pub mod integrate;
 pub mod metrics;
 pub mod model;
+pub mod parallel;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod ribbon;

@@ -11,6 +11,7 @@ use bevy::math::DVec2;
 use bevy::prelude::Reflect;
 
 use crate::model::Edge;
+use crate::parallel::{in_runs, run_each, split_at_cuts};
 
 /// How candidate pairs are found.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -195,56 +196,6 @@ fn fill_cells(
 /// The smallest cell range holding both.
 fn union(a: CellRange, b: CellRange) -> CellRange {
     (a.0.min(b.0), a.1.min(b.1), a.2.max(b.2), a.3.max(b.3))
-}
-
-/// `items` cut before each of `cuts` after the first (ascending, the first 0, the last
-/// `items.len()`): one slice per run.
-fn split_at_cuts<'a, T>(mut items: &'a mut [T], cuts: &[usize]) -> Vec<&'a mut [T]> {
-    let mut runs = Vec::with_capacity(cuts.len().saturating_sub(1));
-    for w in cuts.windows(2) {
-        let (run, rest) = std::mem::take(&mut items).split_at_mut(w[1] - w[0]);
-        runs.push(run);
-        items = rest;
-    }
-    runs
-}
-
-/// `work(i, part)` for every part, the first on this thread and the others on scoped
-/// threads; the results in part order.
-fn run_each<P: Send, R: Send>(parts: Vec<P>, work: impl Fn(usize, P) -> R + Sync) -> Vec<R> {
-    if parts.len() <= 1 {
-        return parts.into_iter().map(|p| work(0, p)).collect();
-    }
-    let work = &work;
-    std::thread::scope(|scope| {
-        let mut parts = parts.into_iter();
-        let first = parts.next().expect("more than one part");
-        let handles: Vec<_> = (parts.enumerate())
-            .map(|(i, p)| scope.spawn(move || work(i + 1, p)))
-            .collect();
-        let mut results = vec![work(0, first)];
-        for h in handles {
-            results.push(h.join().expect("a broad-phase thread panicked"));
-        }
-        results
-    })
-}
-
-/// `work(first index, run)` over `threads` contiguous runs of `items` that start at
-/// multiples of `align`; the results in run order.
-fn in_runs<T: Send, R: Send>(
-    items: &mut [T],
-    threads: usize,
-    align: usize,
-    work: impl Fn(usize, &mut [T]) -> R + Sync,
-) -> Vec<R> {
-    let blocks = items.len().div_ceil(align);
-    let threads = threads.clamp(1, blocks.max(1));
-    let cuts: Vec<usize> = (0..=threads)
-        .map(|t| (blocks * t / threads * align).min(items.len()))
-        .collect();
-    let parts = split_at_cuts(items, &cuts);
-    run_each(parts, |t, run| work(cuts[t], run))
 }
 
 /// A grid of at most this many cells per edge is indexed directly, not hashed.
@@ -578,28 +529,22 @@ impl BroadPhase {
             lane.seen.resize(self.edge_boxes.len(), 0);
             lane.pairs.clear();
         }
-        let (this, work) = (&*self, &work);
-        let (first, rest) = std::thread::scope(|scope| {
-            let handles: Vec<_> = (lanes.iter_mut())
-                .map(|lane| {
-                    scope.spawn(move || {
-                        let QueryLane { range, seen, pairs } = lane;
-                        work(this, range.clone(), seen, pairs)
-                    })
-                })
-                .collect();
-            let first = work(this, 0..n / threads, &mut seen, pairs);
-            let rest: Vec<R> = (handles.into_iter())
-                .map(|h| h.join().expect("a broad-phase thread panicked"))
-                .collect();
-            (first, rest)
+        let mut parts = vec![(0..n / threads, &mut seen[..], &mut *pairs)];
+        for QueryLane { range, seen, pairs } in lanes.iter_mut() {
+            parts.push((range.clone(), &mut seen[..], pairs));
+        }
+        let this = &*self;
+        let results = run_each(parts, |_, (range, seen, pairs)| {
+            work(this, range, seen, pairs)
         });
         for lane in &lanes {
             pairs.extend_from_slice(&lane.pairs);
         }
         self.seen = seen;
         self.lanes = lanes;
-        rest.into_iter().fold(first, combine)
+        let mut results = results.into_iter();
+        let first = results.next().expect("the first share");
+        results.fold(first, combine)
     }
 
     /// The grid queries of the points in `points`, stamped in `seen`.

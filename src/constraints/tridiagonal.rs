@@ -318,95 +318,62 @@ impl TridiagonalFactor {
     pub fn solve_many(&self, columns: &mut [f64], k: usize) {
         match k {
             0 => {}
-            1 => self.solve_rows::<1>(columns),
-            2 => self.solve_rows::<2>(columns),
-            _ => {
-                for c in 0..k {
-                    self.solve_column(columns, k, c);
-                }
-            }
+            1 => self.solve_rows::<1>(columns, 1, 0),
+            2 => self.solve_rows::<2>(columns, 2, 0),
+            _ => (0..k).for_each(|c| self.solve_rows::<1>(columns, k, c)),
         }
     }
 
-    /// [`TridiagonalFactor::solve_many`] for `K` columns known at compile time, both
-    /// halves' chains together; the row just solved stays in registers for the next
-    /// (read back from memory, the store-to-load forwarding would sit on the chain).
-    fn solve_rows<const K: usize>(&self, columns: &mut [f64]) {
+    /// `K` columns from column `offset` of right-hand sides stored row by row, `stride`
+    /// values a row, both halves' chains together; the row just solved stays in
+    /// registers for the next (read back from memory, the store-to-load forwarding
+    /// would sit on the chain).
+    #[inline(always)]
+    fn solve_rows<const K: usize>(&self, columns: &mut [f64], stride: usize, offset: usize) {
         let n = self.len();
         if n == 0 {
             return;
         }
         let (last, m) = (n - 1, n / 2);
-        let rows = columns[..n * K].as_chunks_mut::<K>().0;
+        let at = |i: usize, c: usize| i * stride + offset + c;
         let (mut above, mut below) = ([0.0; K], [0.0; K]);
         for k in 0..m {
             let (inverse, inward) = (self.inverse_pivot[k], self.inward[k]);
             for c in 0..K {
-                above[c] = rows[k][c] * inverse - inward * above[c];
-                rows[k][c] = above[c];
+                above[c] = columns[at(k, c)] * inverse - inward * above[c];
+                columns[at(k, c)] = above[c];
             }
             let j = last - k;
             if j > m {
                 let (inverse, inward) = (self.inverse_pivot[j], self.inward[j]);
                 for c in 0..K {
-                    below[c] = rows[j][c] * inverse - inward * below[c];
-                    rows[j][c] = below[c];
+                    below[c] = columns[at(j, c)] * inverse - inward * below[c];
+                    columns[at(j, c)] = below[c];
                 }
             }
         }
         let (inverse, from_above) = (self.inverse_pivot[m], self.inward[m]);
         for c in 0..K {
-            let value = rows[m][c] * inverse - from_above * above[c] - self.middle_below * below[c];
-            rows[m][c] = value;
+            let value =
+                columns[at(m, c)] * inverse - from_above * above[c] - self.middle_below * below[c];
+            columns[at(m, c)] = value;
             (above[c], below[c]) = (value, value);
         }
         for k in 1..=m {
             let i = m - k;
             let ratio = self.ratio[i];
             for c in 0..K {
-                above[c] = rows[i][c] - ratio * above[c];
-                rows[i][c] = above[c];
+                above[c] = columns[at(i, c)] - ratio * above[c];
+                columns[at(i, c)] = above[c];
             }
             let j = m + k;
             if j < n {
                 let ratio = self.ratio[j];
                 for c in 0..K {
-                    below[c] = rows[j][c] - ratio * below[c];
-                    rows[j][c] = below[c];
+                    below[c] = columns[at(j, c)] - ratio * below[c];
+                    columns[at(j, c)] = below[c];
                 }
             }
-        }
-    }
-
-    /// Column `c` of `k` stored row by row, alone.
-    fn solve_column(&self, columns: &mut [f64], k: usize, c: usize) {
-        let n = self.len();
-        if n == 0 {
-            return;
-        }
-        let (last, m) = (n - 1, n / 2);
-        let at = |i: usize| i * k + c;
-        let (mut above, mut below) = (0.0, 0.0);
-        for i in 0..m {
-            above = columns[at(i)] * self.inverse_pivot[i] - self.inward[i] * above;
-            columns[at(i)] = above;
-        }
-        for j in (m + 1..=last).rev() {
-            below = columns[at(j)] * self.inverse_pivot[j] - self.inward[j] * below;
-            columns[at(j)] = below;
-        }
-        let middle = columns[at(m)] * self.inverse_pivot[m]
-            - self.inward[m] * above
-            - self.middle_below * below;
-        columns[at(m)] = middle;
-        (above, below) = (middle, middle);
-        for i in (0..m).rev() {
-            above = columns[at(i)] - self.ratio[i] * above;
-            columns[at(i)] = above;
-        }
-        for j in m + 1..n {
-            below = columns[at(j)] - self.ratio[j] * below;
-            columns[at(j)] = below;
         }
     }
 }

@@ -9,6 +9,7 @@ use bevy::math::DVec2;
 
 use crate::model::Bend;
 use crate::model::geometry::{turning_angle, wrap_angle};
+use crate::parallel::{run_each, split_at_cuts};
 
 /// Add the bending force of every element.
 pub fn add_bending(bends: &[Bend], position: &[DVec2], velocity: &[DVec2], force: &mut [DVec2]) {
@@ -137,25 +138,10 @@ pub fn add_bending_shared(
         add_bending(bends, position, velocity, force);
         return;
     }
-    std::thread::scope(|scope| {
-        let mut rest = force;
-        let mut own = None;
-        for i in 0..shares.len() {
-            let (base, end) = (shares.bases[i], shares.bases[i + 1]);
-            let (mine, others) = std::mem::take(&mut rest).split_at_mut(end - base);
-            rest = others;
-            let share = (&bends[shares.cuts[i]..shares.cuts[i + 1]], mine, base);
-            match own {
-                None => own = Some(share),
-                Some(_) => {
-                    let (bends, force, base) = share;
-                    scope.spawn(move || add_bending_from(bends, position, velocity, force, base));
-                }
-            }
-        }
-        if let Some((bends, force, base)) = own {
-            add_bending_from(bends, position, velocity, force, base);
-        }
+    let parts = split_at_cuts(force, &shares.bases);
+    run_each(parts, |i, force| {
+        let bends = &bends[shares.cuts[i]..shares.cuts[i + 1]];
+        add_bending_from(bends, position, velocity, force, shares.bases[i]);
     });
 }
 

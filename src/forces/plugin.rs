@@ -48,7 +48,7 @@ pub fn accumulate_forces(
         // The shares depend only on the topology and the thread count.
         let key = Some((topology.version, config.worker_threads()));
         let (cut_for, shares) = &mut *shares;
-        if *cut_for != key || shares.is_empty() {
+        if *cut_for != key {
             shares.cut(&topology.bends, force.len(), config.worker_threads());
             *cut_for = key;
         }
