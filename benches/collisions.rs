@@ -6,6 +6,7 @@
 //! proximity contact with the row below and the contact re-projection has every
 //! island to solve. Each iteration restores the same velocities and
 //! runs the whole stage (proximity, detection, impulses, contact re-projection).
+//! Also the end-of-step crossing check alone on the `scale` layout (100 000 edges).
 //! Run with `cargo bench --bench collisions`; results per machine are in
 //! `benches/RESULTS.md`.
 
@@ -14,7 +15,9 @@ use std::time::{Duration, Instant};
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
-use bevy_strands::collision::broad_phase::BroadPhaseMethod;
+use bevy_strands::collision::broad_phase::{BroadPhase, BroadPhaseMethod};
+use bevy_strands::collision::crossings::count_crossings;
+use bevy_strands::model::Edge;
 use bevy_strands::prelude::*;
 use bevy_strands_app::fixtures::{run_collide_stage, spawn_container};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -112,5 +115,53 @@ fn collide_stage(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, collide_stage);
+/// The `scale` scene's layout at rest: rows of wavy strands of 100 particles 1 cm
+/// apart, rows 4 cm apart, strands 5 cm apart along a row.
+fn scale_layout(strands: usize) -> (Vec<Edge>, Vec<DVec2>) {
+    let (spacing, columns) = (0.01, (strands as f64 / 8.0).sqrt().ceil() as usize);
+    let pitch = DVec2::new((PER_STRAND + 4) as f64 * spacing, 4.0 * spacing);
+    let (mut edges, mut position) = (Vec::new(), Vec::new());
+    for s in 0..strands {
+        let (row, column) = (s / columns, s % columns);
+        let start = DVec2::new(column as f64 * pitch.x, row as f64 * pitch.y);
+        for i in 0..PER_STRAND {
+            let wave = 0.5 * spacing * ((i + 3 * s) as f64 * 0.4).sin();
+            if i > 0 {
+                let a = position.len() as u32 - 1;
+                edges.push(Edge::new(a, a + 1, spacing));
+            }
+            position.push(start + DVec2::new(i as f64 * spacing, wave));
+        }
+    }
+    (edges, position)
+}
+
+/// The crossing check alone (grid build and pair tests) on the `scale` layout.
+fn crossing_check(c: &mut Criterion) {
+    let mut group = c.benchmark_group("crossing_check");
+    group.sample_size(20).warm_up_time(Duration::from_secs(1));
+    let (edges, position) = scale_layout(1000);
+    let (mut broad, mut pairs) = (BroadPhase::default(), Vec::new());
+    group.throughput(Throughput::Elements(edges.len() as u64));
+    for threads in [1usize, 2] {
+        let id = BenchmarkId::new(format!("scale/{threads}t"), edges.len());
+        group.bench_function(id, |b| {
+            b.iter(|| {
+                let found = count_crossings(
+                    &edges,
+                    &position,
+                    &mut broad,
+                    None,
+                    BroadPhaseMethod::Grid,
+                    threads,
+                    &mut pairs,
+                );
+                assert_eq!(found.pairs, 0);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, collide_stage, crossing_check);
 criterion_main!(benches);
