@@ -73,6 +73,7 @@ fn first_problem(world: &World, scene: &Scenario) -> Option<(String, String)> {
         &topology.edges,
         &state.position,
         &mut broad,
+        None,
         config.broad_phase,
         threads,
         &mut Vec::new(),

@@ -94,18 +94,19 @@ struct QueryLane {
     pairs: Vec<(u32, u32)>,
 }
 
-/// Cells `x0..=x1` by `y0..=y1`.
-type CellRange = (i64, i64, i64, i64);
+/// Cells `x0..=x1` by `y0..=y1`: 32-bit, so a build reads and writes half the bytes.
+type CellRange = (i32, i32, i32, i32);
 
-/// `v.floor() as i64`, without the library call `floor` is on baseline x86-64 (it was
-/// a tenth of a step in free fall): the same value for every `v`, ±∞ and NaN included.
-fn floor_to_i64(v: f64) -> i64 {
-    let truncated = v as i64;
-    if (truncated as f64) > v {
-        truncated.saturating_sub(1)
-    } else {
-        truncated
-    }
+/// Scaled coordinates at or beyond this many cells from the origin are not entered in
+/// the grid (the box is tested against everything): every cell index, and every
+/// difference of two, fits in an `i32`.
+const CELL_LIMIT: f64 = (1u32 << 29) as f64;
+
+/// `v.floor() as i32` for `|v| <` [`CELL_LIMIT`], without the library call `floor` is
+/// on baseline x86-64 (it was a tenth of a step in free fall).
+fn floor_to_i32(v: f64) -> i32 {
+    let truncated = v as i32;
+    truncated - i32::from((truncated as f64) > v)
 }
 
 fn hash(ix: i64, iy: i64, mask: usize) -> usize {
@@ -128,16 +129,17 @@ const EMPTY: Aabb = Aabb {
 /// The cells of a box at `inverse_cell` cells per unit, or `None` when it is better
 /// tested against everything than entered in the grid.
 fn cells_of(b: &Aabb, inverse_cell: f64) -> Option<CellRange> {
-    let f = |v: f64| floor_to_i64(v * inverse_cell);
-    let (x0, y0, x1, y1) = (f(b.min.x), f(b.min.y), f(b.max.x), f(b.max.y));
-    let oversized = !b.min.is_finite()
-        || !b.max.is_finite()
-        || x1
-            .saturating_sub(x0)
-            .saturating_add(1)
-            .saturating_mul(y1.saturating_sub(y0).saturating_add(1))
-            > MAX_CELLS_PER_EDGE;
-    (!oversized).then_some((x0, y0, x1, y1))
+    let scaled = [b.min.x, b.min.y, b.max.x, b.max.y].map(|v| v * inverse_cell);
+    // NaN fails the comparison too.
+    let inside = scaled
+        .iter()
+        .fold(true, |inside, v| inside & (v.abs() < CELL_LIMIT));
+    if !inside {
+        return None;
+    }
+    let [x0, y0, x1, y1] = scaled.map(floor_to_i32);
+    let cells = i64::from(x1 - x0 + 1) * i64::from(y1 - y0 + 1);
+    (cells <= MAX_CELLS_PER_EDGE).then_some((x0, y0, x1, y1))
 }
 
 /// The swept boxes of `edges[start..]` into `boxes`, and each block of
@@ -203,9 +205,13 @@ const DENSE_CELLS_PER_EDGE: i64 = 8;
 
 impl BroadPhase {
     /// The bucket of a cell (inside the dense grid, when there is one).
-    fn bucket(&self, ix: i64, iy: i64) -> usize {
+    fn bucket(&self, ix: i32, iy: i32) -> usize {
+        let (ix, iy) = (i64::from(ix), i64::from(iy));
         match self.dense {
-            Some((x0, y0, x1, _)) => ((iy - y0) * (x1 - x0 + 1) + (ix - x0)) as usize,
+            Some((x0, y0, x1, _)) => {
+                let (x0, y0, x1) = (i64::from(x0), i64::from(y0), i64::from(x1));
+                ((iy - y0) * (x1 - x0 + 1) + (ix - x0)) as usize
+            }
             None => hash(ix, iy, self.mask),
         }
     }
@@ -290,7 +296,7 @@ impl BroadPhase {
             bounds
         };
         self.dense = bounds.filter(|&(x0, y0, x1, y1)| {
-            let cells = (x1 - x0 + 1).saturating_mul(y1 - y0 + 1);
+            let cells = i64::from(x1 - x0 + 1) * i64::from(y1 - y0 + 1);
             cells <= DENSE_CELLS_PER_EDGE.saturating_mul(count.max(1) as i64)
         });
         let table = match self.dense {
@@ -353,7 +359,7 @@ impl BroadPhase {
         let cells = &self.edge_cells;
         // Every edge's cells in band t, in edge order: (bucket, edge).
         let enter = |t: usize, visit: &mut dyn FnMut(usize, u32)| {
-            let (from, to) = (y0 + first_row(t) as i64, y0 + first_row(t + 1) as i64);
+            let (from, to) = (y0 + first_row(t) as i32, y0 + first_row(t + 1) as i32);
             for (k, c) in cells.iter().enumerate() {
                 let Some((cx0, cy0, cx1, cy1)) = *c else {
                     continue;
@@ -411,20 +417,20 @@ impl BroadPhase {
         });
     }
 
-    /// Visit each edge whose box overlaps `query` (its cells `cells`) once, in a fixed
-    /// order. `stamp` must differ between consecutive queries on `seen` and be
-    /// non-zero.
+    /// Visit each edge from `first` on whose box overlaps `query` (its cells `cells`)
+    /// once, in a fixed order. `stamp` must differ between consecutive queries on
+    /// `seen` and be non-zero.
     fn visit_cells(
         &self,
         query: &Aabb,
         cells: Option<CellRange>,
-        seen: &mut [u32],
-        stamp: u32,
+        (seen, stamp): (&mut [u32], u32),
+        first: u32,
         mut visit: impl FnMut(u32),
     ) {
         let Some((x0, y0, x1, y1)) = cells else {
             // A huge query: test every edge.
-            for k in 0..self.edge_boxes.len() as u32 {
+            for k in first..self.edge_boxes.len() as u32 {
                 if self.edge_boxes[k as usize].overlaps(query) {
                     visit(k);
                 }
@@ -439,8 +445,11 @@ impl BroadPhase {
         for iy in y0..=y1 {
             for ix in x0..=x1 {
                 let bucket = self.bucket(ix, iy);
-                for slot in self.bucket_start[bucket]..self.bucket_start[bucket + 1] {
-                    let k = self.entries[slot as usize];
+                let run =
+                    self.bucket_start[bucket] as usize..self.bucket_start[bucket + 1] as usize;
+                let run = &self.entries[run];
+                // A bucket's edges are in ascending order (entered in edge order).
+                for &k in &run[run.partition_point(|&k| k < first)..] {
                     if seen[k as usize] != stamp {
                         seen[k as usize] = stamp;
                         if self.edge_boxes[k as usize].overlaps(query) {
@@ -450,12 +459,18 @@ impl BroadPhase {
                 }
             }
         }
-        for i in 0..self.oversized.len() {
-            let k = self.oversized[i];
+        let oversized = &self.oversized;
+        for &k in &oversized[oversized.partition_point(|&k| k < first)..] {
             if self.edge_boxes[k as usize].overlaps(query) {
                 visit(k);
             }
         }
+    }
+
+    /// The boxes of the last build, one per edge (each entered in the grid or tested
+    /// against every query).
+    pub fn boxes(&self) -> &[Aabb] {
+        &self.edge_boxes
     }
 
     fn reset_seen(&mut self) {
@@ -561,7 +576,7 @@ impl BroadPhase {
             let query = Aabb::swept(&[position[i], position[i] + displacement[i]], 0.0);
             let point = i as u32;
             let cells = self.cells(&query);
-            self.visit_cells(&query, cells, seen, point + 1, |k| {
+            self.visit_cells(&query, cells, (seen, point + 1), 0, |k| {
                 if keep(point, k) {
                     pairs.push((point, k));
                 }
@@ -569,9 +584,8 @@ impl BroadPhase {
         }
     }
 
-    /// Over every pair of edges (j < k) whose boxes overlap, in the order
-    /// [`BroadPhase::edge_edge_pairs`] gives them, how many `test` holds for, and the
-    /// first. With `threads` above one and enough edges, contiguous ranges of j are
+    /// Over every pair of edges (j < k) whose boxes overlap, how many `test` holds for,
+    /// and the smallest such (j, k): a pair that does not depend on the grid. With `threads` above one and enough edges, contiguous ranges of j are
     /// tested on that many threads: the same count and the same first pair whatever the
     /// count. Call [`BroadPhase::build`] first.
     pub fn count_edge_pairs(
@@ -604,10 +618,10 @@ impl BroadPhase {
             let j = j as u32;
             let query = self.edge_boxes[j as usize];
             let cells = self.edge_cells[j as usize];
-            self.visit_cells(&query, cells, seen, j + 1, |k| {
-                if k > j && test(j, k) {
+            self.visit_cells(&query, cells, (seen, j + 1), j + 1, |k| {
+                if test(j, k) {
                     count += 1;
-                    first.get_or_insert((j, k));
+                    first = Some(first.map_or((j, k), |f: (u32, u32)| f.min((j, k))));
                 }
             });
         }
@@ -629,8 +643,8 @@ impl BroadPhase {
             match method {
                 BroadPhaseMethod::Grid => {
                     let cells = self.edge_cells[j as usize];
-                    self.visit_cells(&query, cells, &mut seen, j + 1, |k| {
-                        if k > j && keep(j, k) {
+                    self.visit_cells(&query, cells, (&mut seen, j + 1), j + 1, |k| {
+                        if keep(j, k) {
                             pairs.push((j, k));
                         }
                     })
@@ -754,7 +768,7 @@ mod tests {
         broad.edge_edge_pairs(BroadPhaseMethod::Grid, test, &mut listed);
         let one = broad.count_edge_pairs(1, test);
         assert!(one.0 > 1000, "{one:?}");
-        assert_eq!(one, (listed.len(), listed.first().copied()));
+        assert_eq!(one, (listed.len(), listed.iter().min().copied()));
         assert_eq!(broad.count_edge_pairs(2, test), one);
         assert_eq!(broad.count_edge_pairs(3, test), one);
     }

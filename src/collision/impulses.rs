@@ -77,6 +77,12 @@ pub struct ImpulseScratch {
 }
 
 impl ImpulseScratch {
+    /// The broad phase's grid as the last pass built it (the crossing check counts on
+    /// it when it still covers the step-end edges).
+    pub fn grid_mut(&mut self) -> &mut BroadPhase {
+        &mut self.broad
+    }
+
     /// Forget the previous step's contacts and zones; `groups` gives each particle's
     /// rigid group (constraint island).
     pub fn begin_step(&mut self, particles: usize) {

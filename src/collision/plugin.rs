@@ -212,6 +212,7 @@ pub fn check_crossings(
         return;
     }
     let CollisionScratch {
+        impulses,
         crossing_pairs,
         crossing_broad,
         ..
@@ -220,6 +221,7 @@ pub fn check_crossings(
         &topology.edges,
         &state.position,
         crossing_broad,
+        Some(impulses.grid_mut()),
         config.broad_phase,
         step.worker_threads(),
         crossing_pairs,
