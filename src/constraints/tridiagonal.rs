@@ -52,38 +52,62 @@ pub fn solve_tridiagonal(
     let pairs = last - m; // rows below the middle; the rows above are `m` >= `pairs`
     let mut healthy = true;
     let mut chains = Chains::default();
-    for k in 0..m {
-        // Lane 0: row k from above, coupled to k − 1 by lower[k] and to k + 1 by
-        // upper[k]. Lane 1: row j = last − k from below, coupled to j + 1 by upper[j]
-        // and to j − 1 by lower[j]; an idle row (1 on the diagonal) when the rows
-        // above outnumber those below.
-        let j = last - k;
-        let paired = k < pairs;
-        let (inward, linked) = match (k > 0, paired) {
-            (false, _) => ([0.0; 2], [0.0; 2]),
-            (true, true) => (
+    // Each lane's previous outward coupling: `linked` is the inward one times it.
+    let mut previous_outward = [0.0; 2];
+    let mut row = |k: usize, inward: [f64; 2], diagonal: [f64; 2], outward: [f64; 2], b| {
+        let linked = [
+            inward[0] * previous_outward[0],
+            inward[1] * previous_outward[1],
+        ];
+        previous_outward = outward;
+        let result = chains.eliminate(inward, diagonal, outward, linked, b);
+        if k % RESCALE == RESCALE - 1 {
+            chains.rescale();
+        }
+        result
+    };
+    // Lane 0: row k from above, coupled to k − 1 by lower[k] and to k + 1 by upper[k].
+    // Lane 1: row j = last − k from below, coupled to j + 1 by upper[j] and to j − 1 by
+    // lower[j]. In chain order: the first rows (no inward coupling), the rows between
+    // (every coupling, no branch), then, when the rows above outnumber those below, the
+    // last row above beside an idle row (1 on the diagonal). The end rows take one
+    // general form, in two passes with the rows between after the first.
+    for (stage, ends) in [0..m.min(1), pairs.max(1)..m].into_iter().enumerate() {
+        for k in ends {
+            let j = last - k;
+            let paired = k < pairs;
+            let inward = if k > 0 { lower[k] } else { 0.0 };
+            let (diagonal, outward, b) = if paired {
+                (
+                    [diagonal[k], diagonal[j]],
+                    [upper[k], lower[j]],
+                    [rhs[k], rhs[j]],
+                )
+            } else {
+                ([diagonal[k], 1.0], [upper[k], 0.0], [rhs[k], 0.0])
+            };
+            let (values, ratios, usable) = row(k, [inward, 0.0], diagonal, outward, b);
+            healthy &= usable;
+            (rhs[k], scratch[k]) = (values[0], ratios[0]);
+            if paired {
+                (rhs[j], scratch[j]) = (values[1], ratios[1]);
+            }
+        }
+        if stage > 0 {
+            break;
+        }
+        for k in 1..pairs {
+            let j = last - k;
+            let (values, ratios, usable) = row(
+                k,
                 [lower[k], upper[j]],
-                [lower[k] * upper[k - 1], upper[j] * lower[j + 1]],
-            ),
-            (true, false) => ([lower[k], 0.0], [lower[k] * upper[k - 1], 0.0]),
-        };
-        let (diagonal, outward, b) = if paired {
-            (
                 [diagonal[k], diagonal[j]],
                 [upper[k], lower[j]],
                 [rhs[k], rhs[j]],
-            )
-        } else {
-            ([diagonal[k], 1.0], [upper[k], 0.0], [rhs[k], 0.0])
-        };
-        let (values, ratios, usable) = chains.eliminate(inward, diagonal, outward, linked, b);
-        healthy &= usable;
-        (rhs[k], scratch[k]) = (values[0], ratios[0]);
-        if paired {
+            );
+            healthy &= usable;
+            (rhs[k], scratch[k]) = (values[0], ratios[0]);
             (rhs[j], scratch[j]) = (values[1], ratios[1]);
-        }
-        if k % RESCALE == RESCALE - 1 {
-            chains.rescale();
         }
     }
     let from_above = if m > 0 { lower[m] } else { 0.0 };
@@ -101,21 +125,66 @@ pub fn solve_tridiagonal(
     }
     let middle = (rhs[m] - from_above * above_value - from_below * below_value) / pivot;
     rhs[m] = middle;
-    // Back-substitution outwards from the middle, both halves together, each carrying
-    // its last value in a register (through memory, the store-to-load forwarding
-    // would sit on the chain).
-    let (mut inner_above, mut inner_below) = (middle, middle);
-    for k in 1..=pairs {
+    // Back-substitution outwards from the middle, both halves together, each in
+    // registers (through memory, the store-to-load forwarding would sit on the chain)
+    // and two rows at a time as two chains (see `Outward`).
+    let (mut up, mut down) = (Outward::new(middle), Outward::new(middle));
+    let mut k = 1;
+    while k < pairs {
         let (i, j) = (m - k, m + k);
-        inner_above = rhs[i] - scratch[i] * inner_above;
-        rhs[i] = inner_above;
-        inner_below = rhs[j] - scratch[j] * inner_below;
-        rhs[j] = inner_below;
+        let [x0, x1] = up.two([rhs[i], rhs[i - 1]], [scratch[i], scratch[i - 1]]);
+        (rhs[i], rhs[i - 1]) = (x0, x1);
+        let [x0, x1] = down.two([rhs[j], rhs[j + 1]], [scratch[j], scratch[j + 1]]);
+        (rhs[j], rhs[j + 1]) = (x0, x1);
+        k += 2;
     }
-    if m > pairs {
-        rhs[0] -= scratch[0] * inner_above;
+    for k in k..=m {
+        let i = m - k;
+        rhs[i] = up.one(rhs[i], scratch[i]);
+        if k <= pairs {
+            let j = m + k;
+            rhs[j] = down.one(rhs[j], scratch[j]);
+        }
     }
     Ok(())
+}
+
+/// One half's back-substitution, `x_i = y_i − r_i x_{i∓1}` away from the middle. Two
+/// rows at a time it computes `x_{i+2} = (y_{i+2} − r_{i+2} y_{i+1}) + r_{i+2} r_{i+1}
+/// x_i` beside `x_{i+1}`: each waits on a value two rows back, so the half runs as two
+/// chains, and a row's latency halves.
+struct Outward {
+    /// The last two values, the nearer to the middle first.
+    x: [f64; 2],
+    /// The last row's eliminated value and outward ratio.
+    y: f64,
+    r: f64,
+}
+
+impl Outward {
+    /// Starting at the middle row's value (its ratio taken as 0: nothing beyond it).
+    fn new(middle: f64) -> Self {
+        Self {
+            x: [middle; 2],
+            y: middle,
+            r: 0.0,
+        }
+    }
+
+    #[inline(always)]
+    fn one(&mut self, y: f64, r: f64) -> f64 {
+        let x = y - r * self.x[1];
+        (self.x, self.y, self.r) = ([self.x[1], x], y, r);
+        x
+    }
+
+    #[inline(always)]
+    fn two(&mut self, y: [f64; 2], r: [f64; 2]) -> [f64; 2] {
+        let first = (y[0] - r[0] * self.y) + (r[0] * self.r) * self.x[0];
+        let second = (y[1] - r[1] * y[0]) + (r[1] * r[0]) * self.x[1];
+        (self.x, self.y, self.r) = ([first, second], y[1], r[1]);
+        [first, second]
+    }
 }
 
 /// Rows between exact rescalings of the leading minors: two rows of pivots as small
@@ -176,12 +245,17 @@ impl Chains {
     }
 
     /// Multiply each lane by the power of two that brings its latest minor to [1, 2):
-    /// exact, so every ratio is unchanged.
+    /// exact, so every ratio is unchanged. The factor is 2^(1023 − e) for the minor's
+    /// biased exponent e, built by one mask and one subtraction on its bits — this
+    /// sits on the chain, so it is kept short. (A zero or subnormal minor gets 2^1023;
+    /// an infinite or NaN one a non-finite factor, and the pivot check has already
+    /// failed for it.)
     #[inline(always)]
     fn rescale(&mut self) {
+        const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
         for l in 0..2 {
-            let exponent = ((self.previous[l].to_bits() >> 52) & 0x7ff).clamp(1, 2045);
-            let factor = f64::from_bits((2046 - exponent) << 52);
+            let exponent = self.previous[l].to_bits() & EXPONENT;
+            let factor = f64::from_bits(0x7fe0_0000_0000_0000_u64.wrapping_sub(exponent));
             self.previous[l] *= factor;
             self.before[l] *= factor;
             self.value[l] *= factor;
