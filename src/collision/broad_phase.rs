@@ -585,9 +585,10 @@ impl BroadPhase {
     }
 
     /// Over every pair of edges (j < k) whose boxes overlap, how many `test` holds for,
-    /// and the smallest such (j, k): a pair that does not depend on the grid. With `threads` above one and enough edges, contiguous ranges of j are
-    /// tested on that many threads: the same count and the same first pair whatever the
-    /// count. Call [`BroadPhase::build`] first.
+    /// and the smallest such (j, k): a pair that does not depend on the grid. With
+    /// `threads` above one and enough edges, contiguous ranges of j are tested on that
+    /// many threads: the same count and the same first pair whatever the count. Call
+    /// [`BroadPhase::build`] first.
     pub fn count_edge_pairs(
         &mut self,
         threads: usize,
