@@ -57,6 +57,8 @@ fn steady_state_allocates_nothing(scenario: &str) {
     .unwrap();
     let mut app = headless_app(&scene).unwrap();
     let world = app.world_mut();
+    // With the end-of-step crossing check, as the runner's reports have it.
+    world.resource_mut::<CollisionConfig>().check_crossings = true;
     // The counter works: one allocation is seen.
     let probe = allocations_during(|| {
         std::hint::black_box(Vec::<u8>::with_capacity(16));

@@ -75,7 +75,7 @@ pub fn count_crossings(
 const PARALLEL_COVER: usize = 16_384;
 
 /// Whether `boxes` has one box per edge holding both of its ends at `position` (a NaN
-/// end is held by none).
+/// end is held by none). On one thread it allocates nothing.
 pub fn covers(boxes: &[Aabb], edges: &[Edge], position: &[DVec2], threads: usize) -> bool {
     if boxes.len() != edges.len() {
         return false;
@@ -89,11 +89,9 @@ pub fn covers(boxes: &[Aabb], edges: &[Edge], position: &[DVec2], threads: usize
             .all(|(e, b)| holds(b, position[e.a as usize]) && holds(b, position[e.b as usize]))
     };
     let n = edges.len();
-    let threads = if n >= PARALLEL_COVER {
-        threads.max(1)
-    } else {
-        1
-    };
+    if threads <= 1 || n < PARALLEL_COVER {
+        return inside(0..n);
+    }
     let parts: Vec<Range<usize>> = (0..threads)
         .map(|t| n * t / threads..n * (t + 1) / threads)
         .collect();
