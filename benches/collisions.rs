@@ -153,39 +153,28 @@ fn crossing_check(c: &mut Criterion) {
         .collect();
     let mut stage_grid = BroadPhase::default();
     stage_grid.build(&edges, &position, Some(&displacement), 0.004, 1);
-    for threads in [1usize, 2] {
-        let id = BenchmarkId::new(format!("scale_on_stage_grid/{threads}t"), edges.len());
-        group.bench_function(id, |b| {
-            b.iter(|| {
-                let found = count_crossings(
-                    &edges,
-                    &end,
-                    &mut broad,
-                    Some(&mut stage_grid),
-                    BroadPhaseMethod::Grid,
-                    threads,
-                    &mut pairs,
-                );
-                assert_eq!(found.pairs, 0);
-            })
-        });
-    }
-    for threads in [1usize, 2] {
-        let id = BenchmarkId::new(format!("scale/{threads}t"), edges.len());
-        group.bench_function(id, |b| {
-            b.iter(|| {
-                let found = count_crossings(
-                    &edges,
-                    &position,
-                    &mut broad,
-                    None,
-                    BroadPhaseMethod::Grid,
-                    threads,
-                    &mut pairs,
-                );
-                assert_eq!(found.pairs, 0);
-            })
-        });
+    let cases = [
+        ("scale_on_stage_grid", &end, true),
+        ("scale", &position, false),
+    ];
+    for (name, at, on_stage_grid) in cases {
+        for threads in [1usize, 2] {
+            let id = BenchmarkId::new(format!("{name}/{threads}t"), edges.len());
+            group.bench_function(id, |b| {
+                b.iter(|| {
+                    let found = count_crossings(
+                        &edges,
+                        at,
+                        &mut broad,
+                        on_stage_grid.then_some(&mut stage_grid),
+                        BroadPhaseMethod::Grid,
+                        threads,
+                        &mut pairs,
+                    );
+                    assert_eq!(found.pairs, 0);
+                })
+            });
+        }
     }
     group.finish();
 }
