@@ -24,8 +24,7 @@ pub(super) fn localize_rows(
     s: &mut JointScratch,
 ) {
     s.rows.clear();
-    s.part_rows.clear();
-    let (mut particle_offset, mut edge_offset) = (0u32, 0u32);
+    s.placed = (0, 0);
     for (c, row) in rows.iter().enumerate() {
         let tangent = row.normal.perp();
         let along = |direction: DVec2| -> f64 {
@@ -57,13 +56,7 @@ pub(super) fn localize_rows(
                 .iter()
                 .any(|&(q, ..)| q == part)
             {
-                let (_, particles) = s.parts[part as usize].particles;
-                let (_, edges) = s.parts[part as usize].edges;
-                joint.links[joint.link_count as usize] = (part, particle_offset, edge_offset);
-                s.part_rows
-                    .push((part, c as u32, u32::from(joint.link_count)));
-                particle_offset += 2 * particles;
-                edge_offset += 2 * edges;
+                joint.links[joint.link_count as usize] = (part, UNPLACED, UNPLACED);
                 joint.link_count += 1;
             }
         }
@@ -73,17 +66,35 @@ pub(super) fn localize_rows(
         }
         s.rows.push(joint);
     }
-    s.part_rows.sort_unstable();
-    // Room for every row's responses; each is written in full before it is read.
-    if s.particle_responses.len() < particle_offset as usize {
-        s.particle_responses
-            .resize(particle_offset as usize, DVec2::ZERO);
-    }
-    if s.responses.len() < edge_offset as usize {
-        s.responses.resize(edge_offset as usize, 0.0);
-    }
     for &p in &s.packed {
         s.joint_of[p as usize] = NOT_JOINT;
+    }
+}
+
+/// A link's response offsets before its row first takes an impulse.
+const UNPLACED: u32 = u32::MAX;
+
+/// Give link `link` of row `c` room for its responses, after those placed so far in
+/// this projection. Only rows that take an impulse are placed: in the fur three rows
+/// in four never do, and room for every row was most of the projection's memory (and,
+/// on a first step, its page faults). Each response is written in full before it is
+/// read.
+fn place(s: &mut JointScratch, c: usize, link: usize) {
+    let (part, particle_offset, _) = s.rows[c].links[link];
+    if particle_offset != UNPLACED {
+        return;
+    }
+    let (_, particles) = s.parts[part as usize].particles;
+    let (_, edges) = s.parts[part as usize].edges;
+    let (particle_offset, edge_offset) = s.placed;
+    s.rows[c].links[link] = (part, particle_offset, edge_offset);
+    s.placed = (particle_offset + 2 * particles, edge_offset + 2 * edges);
+    let (particle_end, edge_end) = (s.placed.0 as usize, s.placed.1 as usize);
+    if s.particle_responses.len() < particle_end {
+        s.particle_responses.resize(particle_end, DVec2::ZERO);
+    }
+    if s.responses.len() < edge_end {
+        s.responses.resize(edge_end, 0.0);
     }
 }
 
@@ -102,6 +113,7 @@ fn part_of(s: &JointScratch, j: u32) -> usize {
 /// them exact).
 fn row_responses(set: &IslandSet, islands: &[u32], s: &mut JointScratch, c: usize) {
     for link in 0..s.rows[c].link_count as usize {
+        place(s, c, link);
         let part = s.parts[s.rows[c].links[link].0 as usize];
         let factored = part.island != LOOSE && part.edges.1 > 0 && part.factored;
         if !factored {

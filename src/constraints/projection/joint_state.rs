@@ -66,7 +66,7 @@ pub(super) struct JointRow {
     /// Whether its responses are computed (this projection).
     pub(super) ready: bool,
     /// Each part the row touches: `(part, offset in particle responses, offset in
-    /// edge responses)`.
+    /// edge responses)`; the offsets are placed when the row first takes an impulse.
     pub(super) links: [(u32, u32, u32); 2],
     pub(super) link_count: u8,
 }
@@ -103,8 +103,9 @@ pub struct JointScratch {
     /// The packed → joint particle map (free particles of the parts only).
     pub(super) joint_of: Vec<u32>,
     pub(super) rows: Vec<JointRow>,
-    /// `(part, row, link)` of every row's link, by part.
-    pub(super) part_rows: Vec<(u32, u32, u32)>,
+    /// Response room taken so far in this projection: particle responses, edge
+    /// responses.
+    pub(super) placed: (u32, u32),
     /// Responses in edge space, two per link (normal, tangent), `edges` values each.
     pub(super) responses: Vec<f64>,
     /// Responses per particle, two per link (normal, tangent), `particles` each.
