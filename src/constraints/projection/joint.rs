@@ -628,6 +628,44 @@ mod tests {
     }
 
     #[test]
+    fn only_rows_that_take_an_impulse_get_room_for_their_responses() {
+        // Strand A (0..5) falls onto the middle of strand B (5..10) as above; a second
+        // row between A's top and B's end asks for a gap they already keep, so it
+        // never takes an impulse and never forms its responses.
+        let mut position: Vec<DVec2> = (0..5)
+            .map(|i| DVec2::new(0.43, 0.006 + 0.02 * i as f64))
+            .collect();
+        position.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
+        let pairs = [
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 4),
+            (5, 6),
+            (6, 7),
+            (7, 8),
+            (8, 9),
+        ];
+        let world = World::new(position, &pairs, &[]);
+        let dt = 0.01;
+        let mut velocity = vec![DVec2::new(0.0, -1.0); 5];
+        velocity.extend([DVec2::ZERO; 5]);
+        let rows = [
+            row(&world, pair(0, 6, 7, 0.5), DVec2::Y, 0.004, dt),
+            row(&world, pair(4, 8, 9, 0.5), DVec2::Y, 0.0, dt),
+        ];
+        let mut impulses = [RowImpulse::default(); 2];
+        let mut scratch = JointScratch::default();
+        let outcome = world.project(&mut velocity, &rows, &mut impulses, dt, &mut scratch);
+        assert!(outcome.converged, "{outcome:?}");
+        assert!(impulses[0].normal > 0.0 && impulses[1] == RowImpulse::default());
+        // The first row's two links: both strands' 5 particles and 4 edges, normal and
+        // tangent each.
+        assert_eq!(scratch.placed, (2 * (5 + 5), 2 * (4 + 4)));
+        assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+    }
+
+    #[test]
     fn a_contact_holds_a_strand_pushed_into_it_and_lets_go_of_one_pulled_away() {
         // A strand lying on a floor (a pinned edge, particles 6 and 7), touching it at
         // its first particle; its middle particle kicked down, or up.
