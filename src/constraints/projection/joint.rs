@@ -593,10 +593,9 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
-    #[test]
-    fn two_strands_in_contact_push_each_other_and_keep_their_momentum() {
-        // Strand A (0..5) hangs vertically with its lowest particle just above the
-        // middle of strand B (5..10), lying flat; A falls, B rises to meet it.
+    /// Strand A (0..5) hanging vertically with its lowest particle just above the
+    /// middle of strand B (5..10), lying flat.
+    fn two_strands() -> World {
         let mut position: Vec<DVec2> = (0..5)
             .map(|i| DVec2::new(0.43, 0.006 + 0.02 * i as f64))
             .collect();
@@ -611,7 +610,14 @@ mod tests {
             (7, 8),
             (8, 9),
         ];
-        let world = World::new(position, &pairs, &[]);
+        World::new(position, &pairs, &[])
+    }
+
+    #[test]
+    fn two_strands_in_contact_push_each_other_and_keep_their_momentum() {
+        // Strand A (0..5) hangs vertically with its lowest particle just above the
+        // middle of strand B (5..10), lying flat; A falls, B rises to meet it.
+        let world = two_strands();
         let dt = 0.01;
         let mut velocity = vec![DVec2::new(0.3, -1.0); 5];
         velocity[1] = DVec2::new(0.3, -2.0);
@@ -632,21 +638,7 @@ mod tests {
         // Strand A (0..5) falls onto the middle of strand B (5..10) as above; a second
         // row between A's top and B's end asks for a gap they already keep, so it
         // never takes an impulse and never forms its responses.
-        let mut position: Vec<DVec2> = (0..5)
-            .map(|i| DVec2::new(0.43, 0.006 + 0.02 * i as f64))
-            .collect();
-        position.extend((0..5).map(|i| DVec2::new(0.40 + 0.02 * i as f64, 0.0)));
-        let pairs = [
-            (0, 1),
-            (1, 2),
-            (2, 3),
-            (3, 4),
-            (5, 6),
-            (6, 7),
-            (7, 8),
-            (8, 9),
-        ];
-        let world = World::new(position, &pairs, &[]);
+        let world = two_strands();
         let dt = 0.01;
         let mut velocity = vec![DVec2::new(0.0, -1.0); 5];
         velocity.extend([DVec2::ZERO; 5]);
