@@ -103,12 +103,20 @@ impl JointDriver {
         }
         self.group(island, rows);
         let groups = self.groups.count as u32;
-        let lanes = if rows.len() < PARALLEL_ROWS {
+        // A group with most of the rows gets the threads inside its own sweeps: the
+        // groups then run one after another.
+        let largest = (0..groups).map(|g| self.groups.rows_of(g).len()).max();
+        let dominant = largest.is_some_and(|r| 2 * r > rows.len());
+        let lanes = if rows.len() < PARALLEL_ROWS || dominant {
             1
         } else {
             threads.clamp(1, groups.max(1) as usize)
         };
         self.split(lanes, rows.len());
+        let inner = if lanes == 1 { threads } else { 1 };
+        for lane in &mut self.lanes[..lanes] {
+            lane.scratch.set_threads(inner);
+        }
         if groups <= 1 {
             // One group: projected in place, as it comes.
             let lane = &mut self.lanes[0];

@@ -5,17 +5,23 @@
 //! the sweeps add to the corrections when the row's impulse changes) and per edge
 //! (`y = A⁻¹ J W f`, the multipliers it asks of the part's edges, summed once per
 //! Newton step for the edges' tensions).
+//!
+//! The rows come in three groups (`joint_split`): side 0's, side 1's, and those
+//! between. Each sweep visits them in that order; the two sides' rows move disjoint
+//! particles, so on two threads they are swept at once, and the result is the same.
 
 use bevy::math::DVec2;
 
 use super::contact_rows::ContactRow;
-use super::joint_state::{JointRow, JointScratch, LOOSE, NOT_JOINT, RowImpulse};
+use super::joint_state::{Bank, JointRow, JointScratch, LOOSE, NOT_JOINT, Part, RowImpulse};
+use super::scratch::Factors;
 use super::view::IslandView;
 use super::walk::{ChainWalk, GraphWalk, Walk};
 use crate::constraints::islands::IslandSet;
+use crate::parallel::{Partner, with_partner};
 
-/// Translate `rows` into joint rows (one each, in order; a row with no free particle
-/// among the parts stays inert), warm-started from `impulses`.
+/// Translate `rows` into joint rows in the cut's sweep order (a row with no free
+/// particle among the parts stays inert), warm-started from `impulses`.
 pub(super) fn localize_rows(
     rows: &[ContactRow],
     impulses: &[RowImpulse],
@@ -24,8 +30,12 @@ pub(super) fn localize_rows(
     s: &mut JointScratch,
 ) {
     s.rows.clear();
-    s.placed = (0, 0);
-    for (c, row) in rows.iter().enumerate() {
+    for bank in &mut s.banks {
+        bank.placed = (0, 0);
+    }
+    for i in 0..s.cut.rows.len() {
+        let c = s.cut.rows[i] as usize;
+        let row = &rows[c];
         let tangent = row.normal.perp();
         let along = |direction: DVec2| -> f64 {
             (row.particles.iter().zip(row.coefficients))
@@ -51,7 +61,7 @@ pub(super) fn localize_rows(
             }
             joint.entries[joint.count as usize] = (j, coefficient);
             joint.count += 1;
-            let part = part_of(s, j) as u32;
+            let part = part_of(&s.parts, j) as u32;
             if !joint.links[..joint.link_count as usize]
                 .iter()
                 .any(|&(q, ..)| q == part)
@@ -74,91 +84,112 @@ pub(super) fn localize_rows(
 /// A link's response offsets before its row first takes an impulse.
 const UNPLACED: u32 = u32::MAX;
 
-/// Give link `link` of row `c` room for its responses, after those placed so far in
-/// this projection. Only rows that take an impulse are placed: in the fur three rows
-/// in four never do, and room for every row was most of the projection's memory (and,
-/// on a first step, its page faults). Each response is written in full before it is
-/// read.
-fn place(s: &mut JointScratch, c: usize, link: usize) {
-    let (part, particle_offset, _) = s.rows[c].links[link];
+/// Give link `link` of `row` room for its responses in its group's bank, after those
+/// placed so far in this projection. Only rows that take an impulse are placed: in the
+/// fur three rows in four never do, and room for every row was most of the
+/// projection's memory (and, on a first step, its page faults). Each response is
+/// written in full before it is read.
+fn place(bank: &mut Bank, parts: &[Part], row: &mut JointRow, link: usize) {
+    let (part, particle_offset, _) = row.links[link];
     if particle_offset != UNPLACED {
         return;
     }
-    let (_, particles) = s.parts[part as usize].particles;
-    let (_, edges) = s.parts[part as usize].edges;
-    let (particle_offset, edge_offset) = s.placed;
-    s.rows[c].links[link] = (part, particle_offset, edge_offset);
-    s.placed = (particle_offset + 2 * particles, edge_offset + 2 * edges);
-    let (particle_end, edge_end) = (s.placed.0 as usize, s.placed.1 as usize);
-    if s.particle_responses.len() < particle_end {
-        s.particle_responses.resize(particle_end, DVec2::ZERO);
+    let (_, particles) = parts[part as usize].particles;
+    let (_, edges) = parts[part as usize].edges;
+    let (particle_offset, edge_offset) = bank.placed;
+    row.links[link] = (part, particle_offset, edge_offset);
+    bank.placed = (particle_offset + 2 * particles, edge_offset + 2 * edges);
+    let (particle_end, edge_end) = (bank.placed.0 as usize, bank.placed.1 as usize);
+    if bank.particle_responses.len() < particle_end {
+        bank.particle_responses.resize(particle_end, DVec2::ZERO);
     }
-    if s.responses.len() < edge_end {
-        s.responses.resize(edge_end, 0.0);
+    if bank.responses.len() < edge_end {
+        bank.responses.resize(edge_end, 0.0);
     }
 }
 
 /// The part holding joint particle `j` (parts are laid out in particle order).
-fn part_of(s: &JointScratch, j: u32) -> usize {
-    s.parts
-        .partition_point(|p| p.particles.0 + p.particles.1 <= j)
+fn part_of(parts: &[Part], j: u32) -> usize {
+    parts.partition_point(|p| p.particles.0 + p.particles.1 <= j)
 }
 
-/// Row `c`'s responses on each part it touches, normal and tangent: `y = A⁻¹ J W f`
+/// What the sweeps of one Newton step read and never write: the parts, their edges
+/// and their factors.
+#[derive(Clone, Copy)]
+struct Frame<'a> {
+    set: &'a IslandSet,
+    islands: &'a [u32],
+    parts: &'a [Part],
+    inverse_mass: &'a [f64],
+    incident: &'a [(u32, f64)],
+    incident_start: &'a [u32],
+    ends: &'a [(u32, u32)],
+    edge: &'a [DVec2],
+    locked: &'a [bool],
+    part_factors: &'a [Factors],
+}
+
+/// Row `row`'s responses on each part it touches, normal and tangent: `y = A⁻¹ J W f`
 /// with the part's latest factor (a part without one — a loose particle, a singular
 /// system — moves by the direct impulse alone), each particle's `r = W (f − Jᵀ y)`,
 /// and the row's stiffness along both. Computed once per projection, when the row
 /// first takes an impulse: later Newton steps keep it (a response one linearization
 /// old is still a fine direction for the sweeps; the edges' own Newton steps keep
 /// them exact).
-fn row_responses(set: &IslandSet, islands: &[u32], s: &mut JointScratch, c: usize) {
-    for link in 0..s.rows[c].link_count as usize {
-        place(s, c, link);
-        let part = s.parts[s.rows[c].links[link].0 as usize];
+fn row_responses(f: &Frame, bank: &mut Bank, row: &mut JointRow) {
+    for link in 0..row.link_count as usize {
+        place(bank, f.parts, row, link);
+        let part = f.parts[row.links[link].0 as usize];
         let factored = part.island != LOOSE && part.edges.1 > 0 && part.factored;
         if !factored {
-            link_responses(c, link, None::<ChainWalk>, s);
+            link_responses(f, bank, row, link, None::<ChainWalk>);
             continue;
         }
-        match IslandView::of(set, islands[part.island as usize] as usize) {
+        match IslandView::of(f.set, f.islands[part.island as usize] as usize) {
             IslandView::Chain(chain) => link_responses(
-                c,
+                f,
+                bank,
+                row,
                 link,
                 Some(ChainWalk {
                     closed: chain.closed,
                 }),
-                s,
             ),
             IslandView::Graph(graph) => link_responses(
-                c,
+                f,
+                bank,
+                row,
                 link,
                 Some(GraphWalk {
                     layout: graph.layout,
                 }),
-                s,
             ),
         }
     }
-    let tangent = s.rows[c].normal.perp();
-    let diag_n = stiffness(s, c, Along::Normal, s.rows[c].normal);
-    let diag_t = stiffness(s, c, Along::Tangent, tangent);
-    let cross = stiffness(s, c, Along::Normal, tangent);
-    let row = &mut s.rows[c];
-    (row.diag_n, row.diag_t, row.cross, row.ready) = (diag_n, diag_t, cross, true);
+    let tangent = row.normal.perp();
+    row.diag_n = stiffness(f, bank, row, Along::Normal, row.normal);
+    row.diag_t = stiffness(f, bank, row, Along::Tangent, tangent);
+    row.cross = stiffness(f, bank, row, Along::Normal, tangent);
+    row.ready = true;
 }
 
-/// Link `link` of row `c`: its part's responses, solved by `walk` with the part's
+/// Link `link` of `row`: its part's responses, solved by `walk` with the part's
 /// factor, or the direct impulse alone without one.
-fn link_responses<W: Walk>(c: usize, link: usize, walk: Option<W>, s: &mut JointScratch) {
-    let row = s.rows[c];
+fn link_responses<W: Walk>(
+    f: &Frame,
+    bank: &mut Bank,
+    row: &JointRow,
+    link: usize,
+    walk: Option<W>,
+) {
     let (p, particle_offset, edge_offset) = row.links[link];
-    let part = s.parts[p as usize];
+    let part = f.parts[p as usize];
     let (first, particles) = (part.particles.0 as usize, part.particles.1 as usize);
     let (first_edge, m) = (part.edges.0 as usize, part.edges.1 as usize);
     let (particle_offset, edge_offset) = (particle_offset as usize, edge_offset as usize);
     let in_part = |j: u32| (first..first + particles).contains(&(j as usize));
     // Two right-hand sides row by row: column 0 the normal, column 1 the tangent.
-    let columns = &mut s.responses[edge_offset..edge_offset + 2 * m];
+    let columns = &mut bank.responses[edge_offset..edge_offset + 2 * m];
     columns.fill(0.0);
     if let Some(walk) = walk {
         let tangent = row.normal.perp();
@@ -166,48 +197,109 @@ fn link_responses<W: Walk>(c: usize, link: usize, walk: Option<W>, s: &mut Joint
             if !in_part(j) {
                 continue;
             }
-            let w = s.inverse_mass[j as usize] * coefficient;
+            let w = f.inverse_mass[j as usize] * coefficient;
             let range =
-                s.incident_start[j as usize] as usize..s.incident_start[j as usize + 1] as usize;
-            for &(edge, sign) in &s.incident[range] {
+                f.incident_start[j as usize] as usize..f.incident_start[j as usize + 1] as usize;
+            for &(edge, sign) in &f.incident[range] {
                 let edge = edge as usize;
-                if s.locked[edge] {
+                if f.locked[edge] {
                     continue;
                 }
-                let d = 2.0 * sign * w * s.edge[edge];
+                let d = 2.0 * sign * w * f.edge[edge];
                 let i = 2 * (edge - first_edge);
                 columns[i] += d.dot(row.normal);
                 columns[i + 1] += d.dot(tangent);
             }
         }
-        walk.solve_many(m, &s.part_factors[p as usize], columns, 2);
+        walk.solve_many(m, &f.part_factors[p as usize], columns, 2);
     }
     // r = W (f − Jᵀ y) over the part's particles, edge by edge: an edge's multiplier
     // pulls its start along it and its end back (a locked edge's is zero).
     let (normal, tangent) = (row.normal, row.normal.perp());
-    let y = &s.responses[edge_offset..edge_offset + 2 * m];
-    let r = &mut s.particle_responses[particle_offset..particle_offset + 2 * particles];
+    let y = &bank.responses[edge_offset..edge_offset + 2 * m];
+    let r = &mut bank.particle_responses[particle_offset..particle_offset + 2 * particles];
     r.fill(DVec2::ZERO);
     let (r_n, r_t) = r.split_at_mut(particles);
     // Starts first, then ends: along a chain an edge's end is the next one's start,
     // and in one loop each update would wait on the last one's store.
     for k in 0..m {
-        let a = s.ends[first_edge + k].0 as usize;
-        let d = 2.0 * s.inverse_mass[a] * s.edge[first_edge + k];
+        let a = f.ends[first_edge + k].0 as usize;
+        let d = 2.0 * f.inverse_mass[a] * f.edge[first_edge + k];
         r_n[a - first] += y[2 * k] * d;
         r_t[a - first] += y[2 * k + 1] * d;
     }
     for k in 0..m {
-        let b = s.ends[first_edge + k].1 as usize;
-        let d = 2.0 * s.inverse_mass[b] * s.edge[first_edge + k];
+        let b = f.ends[first_edge + k].1 as usize;
+        let d = 2.0 * f.inverse_mass[b] * f.edge[first_edge + k];
         r_n[b - first] -= y[2 * k] * d;
         r_t[b - first] -= y[2 * k + 1] * d;
     }
     for &(j, coefficient) in &row.entries[..row.count as usize] {
         if in_part(j) {
-            let (local, w) = (j as usize - first, s.inverse_mass[j as usize] * coefficient);
+            let (local, w) = (j as usize - first, f.inverse_mass[j as usize] * coefficient);
             r_n[local] += w * normal;
             r_t[local] += w * tangent;
+        }
+    }
+}
+
+/// The corrections a group of rows reads.
+trait Corrections {
+    /// Joint particle `j`'s correction.
+    fn at(&self, j: usize) -> DVec2;
+}
+
+/// The corrections a group of rows reads and writes.
+trait CorrectionsMut: Corrections {
+    /// The corrections of the `count` joint particles from `first` (one part's).
+    fn run_mut(&mut self, first: usize, count: usize) -> &mut [DVec2];
+}
+
+/// The corrections of the joint particles from `first` on.
+struct Run<'a> {
+    first: usize,
+    values: &'a mut [DVec2],
+}
+
+impl Corrections for Run<'_> {
+    #[inline]
+    fn at(&self, j: usize) -> DVec2 {
+        self.values[j - self.first]
+    }
+}
+
+impl CorrectionsMut for Run<'_> {
+    #[inline]
+    fn run_mut(&mut self, first: usize, count: usize) -> &mut [DVec2] {
+        &mut self.values[first - self.first..][..count]
+    }
+}
+
+/// Side 0's corrections and side 1's, which start at joint particle `split`: what the
+/// rows between the sides see.
+struct Sides<'a> {
+    low: &'a mut [DVec2],
+    high: &'a mut [DVec2],
+    split: usize,
+}
+
+impl Corrections for Sides<'_> {
+    #[inline]
+    fn at(&self, j: usize) -> DVec2 {
+        match j.checked_sub(self.split) {
+            Some(k) => self.high[k],
+            None => self.low[j],
+        }
+    }
+}
+
+impl CorrectionsMut for Sides<'_> {
+    #[inline]
+    fn run_mut(&mut self, first: usize, count: usize) -> &mut [DVec2] {
+        // A part lies on one side.
+        match first.checked_sub(self.split) {
+            Some(k) => &mut self.high[k..k + count],
+            None => &mut self.low[first..first + count],
         }
     }
 }
@@ -222,14 +314,118 @@ enum Along {
     Tangent,
 }
 
+/// What the partner thread is asked to do with side 1's rows.
+enum Job<'a> {
+    /// Apply the warm start (`true` on a Newton step's first projection call).
+    Warm(&'a mut [DVec2], bool),
+    /// One sweep.
+    Sweep(&'a mut [DVec2]),
+}
+
+/// Where side 1's jobs run: handed over now, their results taken later.
+trait SideOne<'a> {
+    fn send(&mut self, job: Job<'a>);
+    fn wait(&mut self) -> (&'a mut [DVec2], f64);
+}
+
+/// Side 1's jobs on the partner thread.
+impl<'a> SideOne<'a> for &Partner<Job<'a>, (&'a mut [DVec2], f64)> {
+    fn send(&mut self, job: Job<'a>) {
+        Partner::send(self, job);
+    }
+
+    fn wait(&mut self) -> (&'a mut [DVec2], f64) {
+        Partner::wait(self)
+    }
+}
+
+/// Side 1's jobs on this thread, each run as it is handed over.
+struct Inline<'a, F> {
+    work: F,
+    result: Option<(&'a mut [DVec2], f64)>,
+}
+
+impl<'a, F: FnMut(Job<'a>) -> (&'a mut [DVec2], f64)> SideOne<'a> for Inline<'a, F> {
+    fn send(&mut self, job: Job<'a>) {
+        self.result = Some((self.work)(job));
+    }
+
+    fn wait(&mut self) -> (&'a mut [DVec2], f64) {
+        self.result.take().expect("a job was handed over")
+    }
+}
+
+/// A cut problem's contact solve: side 0's rows here, side 1's wherever `SideOne` runs
+/// them, at the same time, then the rows between; the same order on either.
+struct CutSweeps<'f, 'a> {
+    frame: &'f Frame<'f>,
+    rows_0: &'a mut [JointRow],
+    bank_0: &'a mut Bank,
+    between: &'a mut [JointRow],
+    bank_between: &'a mut Bank,
+    split: usize,
+    first: bool,
+    cap: u32,
+    tolerance: f64,
+}
+
+impl<'a> CutSweeps<'_, 'a> {
+    /// The warm start and the sweeps over side 0's corrections `low` and side 1's
+    /// `high`; returns the sweeps done.
+    fn run(
+        self,
+        low: &'a mut [DVec2],
+        high: &'a mut [DVec2],
+        side_1: &mut impl SideOne<'a>,
+    ) -> u32 {
+        let f = self.frame;
+        side_1.send(Job::Warm(high, self.first));
+        let mut side_0 = Run {
+            first: 0,
+            values: low,
+        };
+        warm(f, self.bank_0, self.rows_0, &mut side_0, self.first);
+        let (high, _) = side_1.wait();
+        let mut sides = Sides {
+            low: side_0.values,
+            high,
+            split: self.split,
+        };
+        warm(f, self.bank_between, self.between, &mut sides, self.first);
+        let mut sweeps = 0;
+        while sweeps < self.cap {
+            sweeps += 1;
+            let Sides { low, high, .. } = sides;
+            side_1.send(Job::Sweep(high));
+            let mut side_0 = Run {
+                first: 0,
+                values: low,
+            };
+            let worst_0 = sweep(f, self.bank_0, self.rows_0, &mut side_0);
+            let (high, worst_1) = side_1.wait();
+            sides = Sides {
+                low: side_0.values,
+                high,
+                split: self.split,
+            };
+            let worst = sweep(f, self.bank_between, self.between, &mut sides);
+            if worst.max(worst_0).max(worst_1) <= self.tolerance {
+                break;
+            }
+        }
+        sweeps
+    }
+}
+
 impl Sweeps {
     /// How far (a distance per step) the most violated normal row falls short at the
     /// current corrections.
     pub(super) fn violation(s: &JointScratch) -> f64 {
+        let correction = Whole(&s.correction);
         s.rows
             .iter()
             .filter(|row| row.count > 0)
-            .map(|row| -(row.slack_n + moved(&s.correction, row, row.normal)))
+            .map(|row| -(row.slack_n + moved(&correction, row, row.normal)))
             .fold(0.0, f64::max)
     }
 
@@ -247,82 +443,179 @@ impl Sweeps {
         tolerance: f64,
     ) -> u32 {
         s.correction.copy_from_slice(&s.base);
-        for c in 0..s.rows.len() {
-            let row = &mut s.rows[c];
-            if first {
-                (row.start_n, row.start_t) = (0.0, 0.0);
+        let frame = Frame {
+            set,
+            islands,
+            parts: &s.parts,
+            inverse_mass: &s.inverse_mass,
+            incident: &s.incident,
+            incident_start: &s.incident_start,
+            ends: &s.ends,
+            edge: &s.edge,
+            locked: &s.locked,
+            part_factors: &s.part_factors,
+        };
+        let (end_0, end_1) = s.cut.row_ends;
+        let (rows_0, rest) = s.rows.split_at_mut(end_0);
+        let (rows_1, between) = rest.split_at_mut(end_1 - end_0);
+        let [bank_0, bank_1, bank_between] = &mut s.banks;
+        let split = s.side_1;
+        let (low, high) = s.correction.split_at_mut(split);
+        let f = &frame;
+        let sweeps = if rows_0.is_empty() && rows_1.is_empty() {
+            // Not cut: one group over every particle (all on side 0).
+            let mut all = Run {
+                first: 0,
+                values: low,
+            };
+            warm(f, bank_between, between, &mut all, first);
+            let mut sweeps = 0;
+            while sweeps < cap {
+                sweeps += 1;
+                if sweep(f, bank_between, between, &mut all) <= tolerance {
+                    break;
+                }
+            }
+            sweeps
+        } else {
+            // Side 1's rows: on a partner thread with two threads, here otherwise.
+            let side_1 = |job| match job {
+                Job::Warm(values, first) => {
+                    let mut run = Run {
+                        first: split,
+                        values,
+                    };
+                    warm(f, bank_1, rows_1, &mut run, first);
+                    (run.values, 0.0)
+                }
+                Job::Sweep(values) => {
+                    let mut run = Run {
+                        first: split,
+                        values,
+                    };
+                    let worst = sweep(f, bank_1, rows_1, &mut run);
+                    (run.values, worst)
+                }
+            };
+            let sides = CutSweeps {
+                frame: f,
+                rows_0,
+                bank_0,
+                between,
+                bank_between,
+                split,
+                first,
+                cap,
+                tolerance,
+            };
+            if s.threads <= 1 {
+                sides.run(
+                    low,
+                    high,
+                    &mut Inline {
+                        work: side_1,
+                        result: None,
+                    },
+                )
             } else {
-                (row.start_n, row.start_t) = (row.mu_n, row.mu_t);
+                with_partner(side_1, |partner| sides.run(low, high, &mut &*partner))
             }
-            let (warm_n, warm_t) = (row.mu_n - row.start_n, row.mu_t - row.start_t);
-            if warm_n != 0.0 || warm_t != 0.0 {
-                if !row.ready {
-                    row_responses(set, islands, s, c);
-                }
-                apply(s, c, warm_n, warm_t);
-            }
-        }
-        let mut sweeps = 0;
-        while sweeps < cap {
-            sweeps += 1;
-            let mut worst = 0.0f64;
-            for c in 0..s.rows.len() {
-                let row = &s.rows[c];
-                if row.count == 0 {
-                    continue;
-                }
-                let value = row.slack_n + moved(&s.correction, row, row.normal);
-                if value >= 0.0 && row.mu_n == 0.0 && row.mu_t == 0.0 {
-                    continue; // met with no impulse: nothing to do
-                }
-                worst = worst.max(-value);
-                if !row.ready {
-                    row_responses(set, islands, s, c);
-                }
-                let row = &s.rows[c];
-                if row.diag_n <= 0.0 {
-                    continue;
-                }
-                // Normal first, then the tangent as the normal change leaves it (the
-                // two share one pass over the corrections).
-                let mu_n = (row.mu_n - value / row.diag_n).max(0.0);
-                let change_n = mu_n - row.mu_n;
-                let mut change_t = 0.0;
-                if row.friction > 0.0 && row.diag_t > 0.0 && (mu_n > 0.0 || row.mu_t != 0.0) {
-                    let value = row.slack_t
-                        + moved(&s.correction, row, row.normal.perp())
-                        + change_n * row.cross;
-                    let cone = row.friction * mu_n;
-                    change_t = (row.mu_t - value / row.diag_t).clamp(-cone, cone) - row.mu_t;
-                }
-                let row = &mut s.rows[c];
-                row.mu_n = mu_n;
-                row.mu_t += change_t;
-                apply(s, c, change_n, change_t);
-            }
-            if worst <= tolerance {
-                break;
-            }
-        }
+        };
         multipliers(s);
         sweeps
     }
 }
 
-/// `Σ cᵢ d·Δᵢ` of `row` along `d` for the corrections `correction`.
+/// Start a Newton step's contact solve for `rows`: note the impulses it starts from
+/// (none on the first, whose warm start is then applied as a change).
+fn warm(
+    f: &Frame,
+    bank: &mut Bank,
+    rows: &mut [JointRow],
+    c: &mut impl CorrectionsMut,
+    first: bool,
+) {
+    for row in rows {
+        if first {
+            (row.start_n, row.start_t) = (0.0, 0.0);
+        } else {
+            (row.start_n, row.start_t) = (row.mu_n, row.mu_t);
+        }
+        let (warm_n, warm_t) = (row.mu_n - row.start_n, row.mu_t - row.start_t);
+        if warm_n != 0.0 || warm_t != 0.0 {
+            if !row.ready {
+                row_responses(f, bank, row);
+            }
+            apply(f, bank, row, c, warm_n, warm_t);
+        }
+    }
+}
+
+/// One projected Gauss–Seidel sweep over `rows`; returns how far the most violated
+/// normal row fell short before its update.
+fn sweep(f: &Frame, bank: &mut Bank, rows: &mut [JointRow], c: &mut impl CorrectionsMut) -> f64 {
+    let mut worst = 0.0f64;
+    for row in rows {
+        if row.count == 0 {
+            continue;
+        }
+        let value = row.slack_n + moved(c, row, row.normal);
+        if value >= 0.0 && row.mu_n == 0.0 && row.mu_t == 0.0 {
+            continue; // met with no impulse: nothing to do
+        }
+        worst = worst.max(-value);
+        if !row.ready {
+            row_responses(f, bank, row);
+        }
+        if row.diag_n <= 0.0 {
+            continue;
+        }
+        // Normal first, then the tangent as the normal change leaves it (the two
+        // share one pass over the corrections).
+        let mu_n = (row.mu_n - value / row.diag_n).max(0.0);
+        let change_n = mu_n - row.mu_n;
+        let mut change_t = 0.0;
+        if row.friction > 0.0 && row.diag_t > 0.0 && (mu_n > 0.0 || row.mu_t != 0.0) {
+            let value = row.slack_t + moved(c, row, row.normal.perp()) + change_n * row.cross;
+            let cone = row.friction * mu_n;
+            change_t = (row.mu_t - value / row.diag_t).clamp(-cone, cone) - row.mu_t;
+        }
+        row.mu_n = mu_n;
+        row.mu_t += change_t;
+        apply(f, bank, row, c, change_n, change_t);
+    }
+    worst
+}
+
+/// Every joint particle's corrections, read only.
+struct Whole<'a>(&'a [DVec2]);
+
+impl Corrections for Whole<'_> {
+    fn at(&self, j: usize) -> DVec2 {
+        self.0[j]
+    }
+}
+
+/// `Σ cᵢ d·Δᵢ` of `row` along `d` for the corrections `c`.
 #[inline]
-fn moved(correction: &[DVec2], row: &JointRow, d: DVec2) -> f64 {
+fn moved(c: &impl Corrections, row: &JointRow, d: DVec2) -> f64 {
     row.entries[..row.count as usize]
         .iter()
-        .map(|&(j, coefficient)| coefficient * d.dot(correction[j as usize]))
+        .map(|&(j, coefficient)| coefficient * d.dot(c.at(j as usize)))
         .sum()
 }
 
-/// The particle responses of link `link` of row `c` along `along`: the part's first
+/// The particle responses of link `link` of `row` along `along`: the part's first
 /// joint particle and the responses.
-fn particle_response(s: &JointScratch, c: usize, link: usize, along: Along) -> (usize, &[DVec2]) {
-    let (part, offset, _) = s.rows[c].links[link];
-    let (first, particles) = s.parts[part as usize].particles;
+fn particle_response<'b>(
+    f: &Frame,
+    bank: &'b Bank,
+    row: &JointRow,
+    link: usize,
+    along: Along,
+) -> (usize, &'b [DVec2]) {
+    let (part, offset, _) = row.links[link];
+    let (first, particles) = f.parts[part as usize].particles;
     let (first, particles) = (first as usize, particles as usize);
     let start = offset as usize
         + if along == Along::Tangent {
@@ -330,16 +623,15 @@ fn particle_response(s: &JointScratch, c: usize, link: usize, along: Along) -> (
         } else {
             0
         };
-    (first, &s.particle_responses[start..start + particles])
+    (first, &bank.particle_responses[start..start + particles])
 }
 
-/// `Σ cᵢ d·rᵢ` over row `c`'s particles for its responses `r` along `along`: its own
+/// `Σ cᵢ d·rᵢ` over `row`'s particles for its responses `r` along `along`: its own
 /// stiffness with `d` the same direction, the cross term with the other.
-fn stiffness(s: &JointScratch, c: usize, along: Along, d: DVec2) -> f64 {
-    let row = &s.rows[c];
+fn stiffness(f: &Frame, bank: &Bank, row: &JointRow, along: Along, d: DVec2) -> f64 {
     let mut value = 0.0;
     for link in 0..row.link_count as usize {
-        let (first, r) = particle_response(s, c, link, along);
+        let (first, r) = particle_response(f, bank, row, link, along);
         for &(j, coefficient) in &row.entries[..row.count as usize] {
             if let Some(r) = r.get((j as usize).wrapping_sub(first)) {
                 value += coefficient * d.dot(*r);
@@ -349,20 +641,24 @@ fn stiffness(s: &JointScratch, c: usize, along: Along, d: DVec2) -> f64 {
     value
 }
 
-/// Add `normal` and `tangent` of row `c`'s impulses to the corrections.
-fn apply(s: &mut JointScratch, c: usize, normal: f64, tangent: f64) {
+/// Add `normal` and `tangent` of `row`'s impulses to the corrections.
+fn apply(
+    f: &Frame,
+    bank: &Bank,
+    row: &JointRow,
+    c: &mut impl CorrectionsMut,
+    normal: f64,
+    tangent: f64,
+) {
     if normal == 0.0 && tangent == 0.0 {
         return;
     }
-    for link in 0..s.rows[c].link_count as usize {
-        let (part, offset, _) = s.rows[c].links[link];
-        let (first, particles) = s.parts[part as usize].particles;
+    for &(part, offset, _) in &row.links[..row.link_count as usize] {
+        let (first, particles) = f.parts[part as usize].particles;
         let (first, particles) = (first as usize, particles as usize);
         let offset = offset as usize;
-        let (correction, r) = (
-            &mut s.correction[first..first + particles],
-            &s.particle_responses[offset..offset + 2 * particles],
-        );
+        let correction = c.run_mut(first, particles);
+        let r = &bank.particle_responses[offset..offset + 2 * particles];
         let (r_n, r_t) = r.split_at(particles);
         // As flat coordinates: the same sums, but the loop vectorizes over them without
         // the shuffles a loop over pairs gets.
@@ -375,11 +671,18 @@ fn apply(s: &mut JointScratch, c: usize, normal: f64, tangent: f64) {
 }
 
 /// The edge multipliers of this Newton step's contact impulses, `Σ dμ y`, per joint
-/// edge (for the edges' tensions).
+/// edge (for the edges' tensions), the rows in sweep order.
 fn multipliers(s: &mut JointScratch) {
     s.contact_multiplier.fill(0.0);
-    for c in 0..s.rows.len() {
-        let row = s.rows[c];
+    let (end_0, end_1) = s.cut.row_ends;
+    for (c, row) in s.rows.iter().enumerate() {
+        let bank = &s.banks[if c < end_0 {
+            0
+        } else if c < end_1 {
+            1
+        } else {
+            2
+        }];
         for (along, amount) in [row.mu_n - row.start_n, row.mu_t - row.start_t]
             .into_iter()
             .enumerate()
@@ -390,7 +693,7 @@ fn multipliers(s: &mut JointScratch) {
             for &(part, _, offset) in &row.links[..row.link_count as usize] {
                 let (first_edge, m) = s.parts[part as usize].edges;
                 let (first_edge, m) = (first_edge as usize, m as usize);
-                let y = &s.responses[offset as usize..offset as usize + 2 * m];
+                let y = &bank.responses[offset as usize..offset as usize + 2 * m];
                 let x = &mut s.contact_multiplier[first_edge..first_edge + m];
                 for (x, y) in x.iter_mut().zip(y.chunks_exact(2)) {
                     *x += amount * y[along];

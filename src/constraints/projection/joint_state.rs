@@ -3,6 +3,7 @@
 
 use bevy::math::DVec2;
 
+use super::joint_split::JointCut;
 use super::scratch::{Factors, IslandScratch};
 
 /// The total impulse a contact row applied (momentum): along its normal (never
@@ -102,14 +103,19 @@ pub struct JointScratch {
     pub(super) edge_impulse: Vec<f64>,
     /// The packed → joint particle map (free particles of the parts only).
     pub(super) joint_of: Vec<u32>,
+    /// The rows in sweep order (`cut.rows` gives each one's index in the caller's).
     pub(super) rows: Vec<JointRow>,
-    /// Response room taken so far in this projection: particle responses, edge
-    /// responses.
-    pub(super) placed: (u32, u32),
-    /// Responses in edge space, two per link (normal, tangent), `edges` values each.
-    pub(super) responses: Vec<f64>,
-    /// Responses per particle, two per link (normal, tangent), `particles` each.
-    pub(super) particle_responses: Vec<DVec2>,
+    /// The response room of side 0's rows, side 1's and those between.
+    pub(super) banks: [Bank; 3],
+    /// The members' layout order and the rows' sweep order.
+    pub(super) cut: JointCut,
+    /// Each member's part.
+    pub(super) part_of_member: Vec<u32>,
+    /// The first joint particle of side 1 (every particle when the problem is not
+    /// cut).
+    pub(super) side_1: usize,
+    /// Threads the sweeps may use.
+    pub(super) threads: usize,
     pub(super) island: IslandScratch,
     /// Each part's factor at the Newton step that last factored it.
     pub(super) part_factors: Vec<Factors>,
@@ -117,18 +123,37 @@ pub struct JointScratch {
     pub(super) met: Vec<bool>,
 }
 
+/// Room for the responses of one group of rows, taken as they first push.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Bank {
+    /// Room taken so far in this projection: particle responses, edge responses.
+    pub(super) placed: (u32, u32),
+    /// Responses in edge space, two per link (normal, tangent), `edges` values each.
+    pub(super) responses: Vec<f64>,
+    /// Responses per particle, two per link (normal, tangent), `particles` each.
+    pub(super) particle_responses: Vec<DVec2>,
+}
+
 impl JointScratch {
+    /// Let the sweeps of a large projection use up to `threads` threads (the result
+    /// is the same whatever the count).
+    pub fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+    }
+
     /// After [`project_jointly`](super::project_jointly): whether the island passed as `islands[i]` met its
     /// edges (and had its corrections applied).
     pub fn island_met(&self, i: usize) -> bool {
-        self.met.get(i).copied().unwrap_or(false)
+        let part = self.part_of_member.get(i).copied();
+        part.and_then(|p| self.met.get(p as usize).copied())
+            .unwrap_or(false)
     }
 
     /// After [`project_jointly`](super::project_jointly): the impulse each edge of the island passed as
     /// `islands[i]` carried (mass × length, tension positive), in the island's edge
     /// order.
     pub fn edge_impulses(&self, i: usize) -> &[f64] {
-        let (first, count) = self.parts[i].edges;
+        let (first, count) = self.parts[self.part_of_member[i] as usize].edges;
         &self.edge_impulse[first as usize..(first + count) as usize]
     }
 }

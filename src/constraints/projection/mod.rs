@@ -34,6 +34,7 @@ mod assembly;
 mod contact_rows;
 mod joint;
 mod joint_rows;
+mod joint_split;
 mod joint_state;
 mod newton;
 mod scratch;
