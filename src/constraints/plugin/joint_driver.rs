@@ -11,8 +11,8 @@ use bevy::math::DVec2;
 use crate::constraints::islands::IslandSet;
 use crate::constraints::joint_groups::{JointGroups, NONE, RowSlots};
 use crate::constraints::projection::{
-    Bodies, ContactRow, JointOutcome, JointScratch, JointSettings, ProjectionOutcome, RowImpulse,
-    project_jointly,
+    Bodies, ContactRow, JOINT_CUT_ROWS, JointOutcome, JointScratch, JointSettings,
+    ProjectionOutcome, RowImpulse, project_jointly,
 };
 use crate::metrics::IterationStats;
 use crate::model::NO_ISLAND;
@@ -103,10 +103,10 @@ impl JointDriver {
         }
         self.group(island, rows);
         let groups = self.groups.count as u32;
-        // A group with most of the rows gets the threads inside its own sweeps: the
-        // groups then run one after another.
+        // A group with most of the rows, large enough to be cut, gets the threads inside
+        // its own sweeps: the groups then run one after another.
         let largest = (0..groups).map(|g| self.groups.rows_of(g).len()).max();
-        let dominant = largest.is_some_and(|r| 2 * r > rows.len());
+        let dominant = largest.is_some_and(|r| r >= JOINT_CUT_ROWS && 2 * r > rows.len());
         let lanes = if rows.len() < PARALLEL_ROWS || dominant {
             1
         } else {

@@ -16,7 +16,7 @@ use crate::constraints::islands::IslandSet;
 
 /// A joint projection with fewer rows than this is swept as one: the cut costs a pass
 /// over the rows and a thread hand-off per sweep, which small problems do not repay.
-pub(super) const CUT_ROWS: usize = 2048;
+pub const CUT_ROWS: usize = 2048;
 
 /// What a row that pushes weighs against one that is only checked, in the sweeps'
 /// work (measured on the furry creature: a row update writes two responses on about

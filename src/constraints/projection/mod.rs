@@ -44,6 +44,7 @@ mod walk;
 
 pub use contact_rows::ContactRow;
 pub use joint::{JointOutcome, JointSettings, project_jointly};
+pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
 pub use joint_state::{JointScratch, RowImpulse};
 pub use scratch::IslandScratch;
 pub use settings::{ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
