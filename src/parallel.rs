@@ -112,11 +112,11 @@ pub fn with_partner<J: Send, R: Send, T>(
     std::thread::scope(|scope| {
         let p = &partner;
         scope.spawn(move || {
-            let _dead = Leave(&p.state, DEAD);
+            let dead = Leave(&p.state, DEAD);
             loop {
                 if spin_until(&p.state, |s| s == POSTED || s == QUIT) == QUIT {
                     // Not dead: it left as asked.
-                    std::mem::forget(_dead);
+                    std::mem::forget(dead);
                     return;
                 }
                 let job = lock(&p.job).take().expect("a posted job");
@@ -127,7 +127,7 @@ pub fn with_partner<J: Send, R: Send, T>(
                     .compare_exchange(POSTED, DONE, Ordering::AcqRel, Ordering::Acquire)
                     .is_err()
                 {
-                    std::mem::forget(_dead);
+                    std::mem::forget(dead);
                     return;
                 }
             }

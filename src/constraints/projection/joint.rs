@@ -71,7 +71,7 @@ pub struct JointOutcome {
 }
 
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
-/// polished alone (if the contact tolerance allows no less): the polish then moves
+/// polished alone (if what the rows fall short allows no less): the polish then moves
 /// particles by at most a few ten-thousandths of an edge. Lower, rows that have
 /// stalled keep the Newton steps going while their sweeps stir the edges back above
 /// it (the fur held at 2e-4 for ten Newton steps of 16 sweeps each).
@@ -323,12 +323,12 @@ fn iterate(
         let violation = Sweeps::violation(s);
         outcome.residual = residual;
         outcome.contact_violation = violation;
-        // The rows are met, or met as well as the sweeps manage once that stops
-        // improving: freeze them, and polish the edges alone.
         // The polish moves particles by about the residual times an edge: the rows are
         // frozen only once that is no more than they already fall short (the contact
         // tolerance, or where the sweeps stalled above it).
         let polish = JOINT_POLISH.min(contact_tolerance.max(violation) / shortest);
+        // The rows are met, or met as well as the sweeps manage once that stops
+        // improving: freeze them, and polish the edges alone.
         let settled = residual <= polish
             && (violation <= contact_tolerance || violation > 0.5 * previous_violation);
         // Rows that keep the edges from settling for `rows_give_way` Newton steps (a large

@@ -111,10 +111,10 @@ pub struct JointScratch {
     pub(super) cut: JointCut,
     /// Each member's part.
     pub(super) part_of_member: Vec<u32>,
-    /// The first joint particle of side 1 (every particle when the problem is not
-    /// cut).
+    /// The first joint particle of side 1 (the particle count when the problem is not
+    /// cut: every particle is then on side 0).
     pub(super) side_1: usize,
-    /// Threads the sweeps may use.
+    /// Threads the sweeps may use (a cut problem's sides take two at most).
     pub(super) threads: usize,
     pub(super) island: IslandScratch,
     /// Each part's factor at the Newton step that last factored it.
@@ -135,8 +135,8 @@ pub(super) struct Bank {
 }
 
 impl JointScratch {
-    /// Let the sweeps of a large projection use up to `threads` threads (the result
-    /// is the same whatever the count).
+    /// Let the sweeps of a cut projection run its two sides at once when `threads` is
+    /// more than one (the result is the same whatever the count).
     pub fn set_threads(&mut self, threads: usize) {
         self.threads = threads;
     }
