@@ -1,5 +1,5 @@
 //! Contact rows: the inequalities `Σ cᵢ n·vᵢ ≥ target` a joint projection must
-//! respect, with friction along their tangent.
+//! respect, with friction along their tangent, and the impulses they carry.
 
 use bevy::math::DVec2;
 
@@ -19,6 +19,16 @@ pub struct ContactRow {
     /// Coulomb friction coefficient of the row's tangential part (a joint projection
     /// stops sliding along `normal.perp()` with at most this times the normal impulse).
     pub friction: f64,
+}
+
+/// The total impulse a contact row applied (momentum): along its normal (never
+/// negative) and along its tangent (within the friction cone).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowImpulse {
+    /// Along the normal, pushing apart.
+    pub normal: f64,
+    /// Along the tangent `normal.perp()`.
+    pub tangent: f64,
 }
 
 impl ContactRow {

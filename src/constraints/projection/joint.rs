@@ -25,9 +25,10 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::ContactRow;
+use super::contact_rows::{ContactRow, RowImpulse};
 use super::joint_rows::{Sweeps, localize_rows};
-use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part, RowImpulse};
+use super::joint_split::Members;
+use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part};
 use super::scratch::Factors;
 use super::settings::{ConstraintDirection, ProjectionSettings, ROUND_OFF_FLOOR};
 use super::view::{Bodies, IslandView};
@@ -100,7 +101,12 @@ pub fn project_jointly(
         velocity,
         inverse_mass,
     } = bodies;
-    (scratch.cut).cut(set, islands, loose, position, inverse_mass, rows, impulses);
+    let members = Members {
+        set,
+        islands,
+        loose,
+    };
+    (scratch.cut).cut(members, position, inverse_mass, rows, impulses);
     lay_out(
         set,
         islands,

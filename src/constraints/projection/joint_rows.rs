@@ -12,8 +12,8 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::ContactRow;
-use super::joint_state::{Bank, JointRow, JointScratch, LOOSE, NOT_JOINT, Part, RowImpulse};
+use super::contact_rows::{ContactRow, RowImpulse};
+use super::joint_state::{Bank, JointRow, JointScratch, LOOSE, NOT_JOINT, Part};
 use super::scratch::Factors;
 use super::view::IslandView;
 use super::walk::{ChainWalk, GraphWalk, Walk};
@@ -249,6 +249,14 @@ trait Corrections {
     fn at(&self, j: usize) -> DVec2;
 }
 
+/// Every joint particle's corrections.
+impl Corrections for [DVec2] {
+    #[inline]
+    fn at(&self, j: usize) -> DVec2 {
+        self[j]
+    }
+}
+
 /// The corrections a group of rows reads and writes.
 trait CorrectionsMut: Corrections {
     /// The corrections of the `count` joint particles from `first` (one part's).
@@ -355,8 +363,9 @@ impl<'a, F: FnMut(Job<'a>) -> (&'a mut [DVec2], f64)> SideOne<'a> for Inline<'a,
     }
 }
 
-/// A cut problem's contact solve: side 0's rows here, side 1's wherever `SideOne` runs
-/// them, at the same time, then the rows between; the same order on either.
+/// A joint projection's contact solve: side 0's rows here, side 1's wherever `SideOne`
+/// runs them, at the same time, then the rows between; the same order on either (a
+/// problem that is not cut has only rows between).
 struct CutSweeps<'f, 'a> {
     frame: &'f Frame<'f>,
     rows_0: &'a mut [JointRow],
@@ -421,11 +430,11 @@ impl Sweeps {
     /// How far (a distance per step) the most violated normal row falls short at the
     /// current corrections.
     pub(super) fn violation(s: &JointScratch) -> f64 {
-        let correction = Whole(&s.correction);
+        let correction = s.correction.as_slice();
         s.rows
             .iter()
             .filter(|row| row.count > 0)
-            .map(|row| -(row.slack_n + moved(&correction, row, row.normal)))
+            .map(|row| -(row.slack_n + moved(correction, row, row.normal)))
             .fold(0.0, f64::max)
     }
 
@@ -462,64 +471,49 @@ impl Sweeps {
         let split = s.side_1;
         let (low, high) = s.correction.split_at_mut(split);
         let f = &frame;
-        let sweeps = if rows_0.is_empty() && rows_1.is_empty() {
-            // Not cut: one group over every particle (all on side 0).
-            let mut all = Run {
-                first: 0,
-                values: low,
-            };
-            warm(f, bank_between, between, &mut all, first);
-            let mut sweeps = 0;
-            while sweeps < cap {
-                sweeps += 1;
-                if sweep(f, bank_between, between, &mut all) <= tolerance {
-                    break;
-                }
+        // Side 1's rows: on a partner thread with two threads, here otherwise. A problem
+        // that is not cut has every particle on side 0 and every row between.
+        let cut = !rows_0.is_empty() || !rows_1.is_empty();
+        let side_1 = |job| match job {
+            Job::Warm(values, first) => {
+                let mut run = Run {
+                    first: split,
+                    values,
+                };
+                warm(f, bank_1, rows_1, &mut run, first);
+                (run.values, 0.0)
             }
-            sweeps
+            Job::Sweep(values) => {
+                let mut run = Run {
+                    first: split,
+                    values,
+                };
+                let worst = sweep(f, bank_1, rows_1, &mut run);
+                (run.values, worst)
+            }
+        };
+        let sides = CutSweeps {
+            frame: f,
+            rows_0,
+            bank_0,
+            between,
+            bank_between,
+            split,
+            first,
+            cap,
+            tolerance,
+        };
+        let sweeps = if s.threads <= 1 || !cut {
+            sides.run(
+                low,
+                high,
+                &mut Inline {
+                    work: side_1,
+                    result: None,
+                },
+            )
         } else {
-            // Side 1's rows: on a partner thread with two threads, here otherwise.
-            let side_1 = |job| match job {
-                Job::Warm(values, first) => {
-                    let mut run = Run {
-                        first: split,
-                        values,
-                    };
-                    warm(f, bank_1, rows_1, &mut run, first);
-                    (run.values, 0.0)
-                }
-                Job::Sweep(values) => {
-                    let mut run = Run {
-                        first: split,
-                        values,
-                    };
-                    let worst = sweep(f, bank_1, rows_1, &mut run);
-                    (run.values, worst)
-                }
-            };
-            let sides = CutSweeps {
-                frame: f,
-                rows_0,
-                bank_0,
-                between,
-                bank_between,
-                split,
-                first,
-                cap,
-                tolerance,
-            };
-            if s.threads <= 1 {
-                sides.run(
-                    low,
-                    high,
-                    &mut Inline {
-                        work: side_1,
-                        result: None,
-                    },
-                )
-            } else {
-                with_partner(side_1, |partner| sides.run(low, high, &mut &*partner))
-            }
+            with_partner(side_1, |partner| sides.run(low, high, &mut &*partner))
         };
         multipliers(s);
         sweeps
@@ -587,18 +581,9 @@ fn sweep(f: &Frame, bank: &mut Bank, rows: &mut [JointRow], c: &mut impl Correct
     worst
 }
 
-/// Every joint particle's corrections, read only.
-struct Whole<'a>(&'a [DVec2]);
-
-impl Corrections for Whole<'_> {
-    fn at(&self, j: usize) -> DVec2 {
-        self.0[j]
-    }
-}
-
 /// `Σ cᵢ d·Δᵢ` of `row` along `d` for the corrections `c`.
 #[inline]
-fn moved(c: &impl Corrections, row: &JointRow, d: DVec2) -> f64 {
+fn moved<C: Corrections + ?Sized>(c: &C, row: &JointRow, d: DVec2) -> f64 {
     row.entries[..row.count as usize]
         .iter()
         .map(|&(j, coefficient)| coefficient * d.dot(c.at(j as usize)))

@@ -10,8 +10,7 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::ContactRow;
-use super::joint_state::RowImpulse;
+use super::contact_rows::{ContactRow, RowImpulse};
 use crate::constraints::islands::IslandSet;
 
 /// A joint projection with fewer rows than this is swept as one: the cut costs a pass
@@ -49,23 +48,50 @@ pub(super) struct JointCut {
     weight: Vec<u32>,
     side: Vec<u8>,
     order: Vec<u32>,
+    class: Vec<u8>,
+}
+
+/// The members of a joint projection: the islands `islands` of `set`, then the
+/// `loose` particles.
+#[derive(Clone, Copy)]
+pub(super) struct Members<'a> {
+    pub(super) set: &'a IslandSet,
+    pub(super) islands: &'a [u32],
+    pub(super) loose: &'a [u32],
+}
+
+impl Members<'_> {
+    fn len(&self) -> usize {
+        self.islands.len() + self.loose.len()
+    }
+
+    /// Member `m`'s particles: both ends of each of an island's edges, or the loose
+    /// particle.
+    fn particles(&self, m: usize) -> impl Iterator<Item = usize> + '_ {
+        let (edges, loose) = match self.islands.get(m) {
+            Some(&i) => (
+                &self.set.edges[self.set.islands[i as usize].edges.clone()],
+                None,
+            ),
+            None => (&[][..], Some(self.loose[m - self.islands.len()] as usize)),
+        };
+        (edges.iter())
+            .flat_map(|e| [e.a as usize, e.b as usize])
+            .chain(loose)
+    }
 }
 
 impl JointCut {
-    /// Cut the members (`islands` of `set`, then the `loose` particles) and `rows`
-    /// (`impulses` their warm starts).
-    #[allow(clippy::too_many_arguments)]
+    /// Cut `of` and `rows` (`impulses` their warm starts).
     pub(super) fn cut(
         &mut self,
-        set: &IslandSet,
-        islands: &[u32],
-        loose: &[u32],
+        of: Members,
         position: &[DVec2],
         inverse_mass: &[f64],
         rows: &[ContactRow],
         impulses: &[RowImpulse],
     ) {
-        let members = islands.len() + loose.len();
+        let members = of.len();
         self.members.clear();
         self.members.extend(0..members as u32);
         self.side_0 = members;
@@ -75,17 +101,13 @@ impl JointCut {
         if rows.len() < CUT_ROWS || members < 2 {
             return;
         }
-        self.locate(set, islands, loose, position, inverse_mass);
+        self.locate(of, position, inverse_mass);
         self.weigh(rows, impulses, members);
         self.halve(members);
         self.sort_rows(rows);
-        for &p in loose {
-            self.member_of[p as usize] = NO_MEMBER;
-        }
-        for &island in islands {
-            for e in &set.edges[set.islands[island as usize].edges.clone()] {
-                self.member_of[e.a as usize] = NO_MEMBER;
-                self.member_of[e.b as usize] = NO_MEMBER;
+        for m in 0..members {
+            for p in of.particles(m) {
+                self.member_of[p] = NO_MEMBER;
             }
         }
         let (end_0, end_1) = self.row_ends;
@@ -98,35 +120,23 @@ impl JointCut {
         }
     }
 
-    /// Each member's free particles and centre (the mean of its edges' ends).
-    fn locate(
-        &mut self,
-        set: &IslandSet,
-        islands: &[u32],
-        loose: &[u32],
-        position: &[DVec2],
-        inverse_mass: &[f64],
-    ) {
+    /// Each member's free particles and centre (the mean of its particles, an
+    /// island's counted once per edge end).
+    fn locate(&mut self, of: Members, position: &[DVec2], inverse_mass: &[f64]) {
         if self.member_of.len() < inverse_mass.len() {
             self.member_of.resize(inverse_mass.len(), NO_MEMBER);
         }
         self.centre.clear();
-        for (m, &island) in islands.iter().enumerate() {
-            let edges = &set.edges[set.islands[island as usize].edges.clone()];
-            let mut sum = DVec2::ZERO;
-            for e in edges {
-                for p in [e.a as usize, e.b as usize] {
-                    sum += position[p];
-                    if inverse_mass[p] > 0.0 {
-                        self.member_of[p] = m as u32;
-                    }
+        for m in 0..of.len() {
+            let (mut sum, mut count) = (DVec2::ZERO, 0usize);
+            for p in of.particles(m) {
+                sum += position[p];
+                count += 1;
+                if inverse_mass[p] > 0.0 {
+                    self.member_of[p] = m as u32;
                 }
             }
-            self.centre.push(sum / (2 * edges.len()).max(1) as f64);
-        }
-        for (k, &p) in loose.iter().enumerate() {
-            self.member_of[p as usize] = (islands.len() + k) as u32;
-            self.centre.push(position[p as usize]);
+            self.centre.push(sum / count.max(1) as f64);
         }
     }
 
@@ -186,7 +196,7 @@ impl JointCut {
     /// The rows in sweep order: side 0's, side 1's, then those between (or touching no
     /// member), each in the order given.
     fn sort_rows(&mut self, rows: &[ContactRow]) {
-        self.order.clear();
+        self.class.clear();
         for row in rows {
             let mut class = None;
             for m in self.members_of(row) {
@@ -200,12 +210,10 @@ impl JointCut {
                     Some(_) => Some(BETWEEN),
                 };
             }
-            self.order.push(u32::from(class.unwrap_or(BETWEEN)));
+            self.class.push(class.unwrap_or(BETWEEN));
         }
-        let order = &self.order;
-        let of = |want: u8| {
-            (0..rows.len() as u32).filter(move |&c| order[c as usize] == u32::from(want))
-        };
+        let classes = &self.class;
+        let of = |want: u8| (0..rows.len() as u32).filter(move |&c| classes[c as usize] == want);
         self.rows.clear();
         self.rows.extend(of(SIDE_0));
         let end_0 = self.rows.len();
@@ -259,6 +267,15 @@ mod tests {
         }
     }
 
+    /// The islands `islands` of `set`, no loose particles.
+    fn members<'a>(set: &'a IslandSet, islands: &'a [u32]) -> Members<'a> {
+        Members {
+            set,
+            islands,
+            loose: &[],
+        }
+    }
+
     /// Every island of `set`, in order.
     fn islands_of(set: &IslandSet) -> Vec<u32> {
         (0..set.islands.len() as u32).collect()
@@ -289,7 +306,13 @@ mod tests {
             });
         }
         let mut cut = JointCut::default();
-        cut.cut(&set, &islands, &[], &position, &inverse_mass, &rows, &[]);
+        cut.cut(
+            members(&set, &islands),
+            &position,
+            &inverse_mass,
+            &rows,
+            &[],
+        );
         let left = [island_of(0), island_of(3)];
         let right = [island_of(6), island_of(9)];
         assert_eq!(cut.side_0, 2);
@@ -334,14 +357,20 @@ mod tests {
         let islands = islands_of(&set);
         let mut cut = JointCut::default();
         let few = vec![row(0, 3, 4); CUT_ROWS - 1];
-        cut.cut(&set, &islands, &[], &position, &inverse_mass, &few, &[]);
+        cut.cut(members(&set, &islands), &position, &inverse_mass, &few, &[]);
         assert_eq!(cut.row_ends, (0, 0));
         assert_eq!(cut.side_0, islands.len());
         assert_eq!(cut.members, islands);
         // Enough rows, but all between the left pair and the right: no side has rows
         // of its own.
         let between = vec![row(4, 6, 7); CUT_ROWS];
-        cut.cut(&set, &islands, &[], &position, &inverse_mass, &between, &[]);
+        cut.cut(
+            members(&set, &islands),
+            &position,
+            &inverse_mass,
+            &between,
+            &[],
+        );
         assert_eq!(cut.row_ends, (0, 0));
         assert_eq!(cut.members, islands);
         assert_eq!(cut.rows, (0..CUT_ROWS as u32).collect::<Vec<_>>());

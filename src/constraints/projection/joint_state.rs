@@ -6,16 +6,6 @@ use bevy::math::DVec2;
 use super::joint_split::JointCut;
 use super::scratch::{Factors, IslandScratch};
 
-/// The total impulse a contact row applied (momentum): along its normal (never
-/// negative) and along its tangent (within the friction cone).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RowImpulse {
-    /// Along the normal, pushing apart.
-    pub normal: f64,
-    /// Along the tangent `normal.perp()`.
-    pub tangent: f64,
-}
-
 /// One part of the joint problem: an island, or a loose free particle (no edges).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Part {

@@ -42,10 +42,10 @@ mod settings;
 mod view;
 mod walk;
 
-pub use contact_rows::ContactRow;
+pub use contact_rows::{ContactRow, RowImpulse};
 pub use joint::{JointOutcome, JointSettings, project_jointly};
 pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
-pub use joint_state::{JointScratch, RowImpulse};
+pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
 pub use settings::{ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
 pub use view::{Bodies, Chain, Graph, IslandView};
