@@ -3,8 +3,8 @@
 //! The stages that share work between threads cut it into parts that each write only
 //! their own slices, so the results do not depend on how many threads ran them.
 
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicU32, Ordering};
+use std::sync::{Condvar, Mutex};
 
 /// `items` cut before each of `cuts` after the first (ascending, the first 0, the last
 /// `items.len()`): one slice per run.
@@ -58,13 +58,94 @@ pub fn in_runs<T: Send, R: Send>(
 
 /// A second thread that runs jobs handed to it one at a time, in lock step with the
 /// thread that hands them over: for work cut into short rounds (a few tens of
-/// microseconds) that spawning a thread per round would swamp. It spins between jobs,
-/// yielding once a wait grows long.
+/// microseconds) that spawning a thread per round would swamp. Each side spins a few
+/// microseconds for the other, then sleeps until woken: spinning on, a busy machine
+/// (a game's own threads) would take the core the other side needs.
 pub struct Partner<J, R> {
-    state: AtomicU8,
+    state: Signal,
     job: Mutex<Option<J>>,
     result: Mutex<Option<R>>,
 }
+
+/// A state both sides watch: spun on briefly, then slept on.
+struct Signal {
+    state: AtomicU8,
+    /// Threads asleep on `wake` (or about to be).
+    sleepers: AtomicU32,
+    lock: Mutex<()>,
+    wake: Condvar,
+}
+
+impl Signal {
+    fn new() -> Signal {
+        Signal {
+            state: AtomicU8::new(IDLE),
+            sleepers: AtomicU32::new(0),
+            lock: Mutex::new(()),
+            wake: Condvar::new(),
+        }
+    }
+
+    fn load(&self) -> u8 {
+        self.state.load(Ordering::SeqCst)
+    }
+
+    /// Set the state and wake whoever sleeps on it.
+    fn store(&self, state: u8) {
+        self.state.store(state, Ordering::SeqCst);
+        self.notify();
+    }
+
+    /// Set the state from `from` to `to`, if it is still `from`.
+    fn swap_from(&self, from: u8, to: u8) -> bool {
+        let swapped = (self.state)
+            .compare_exchange(from, to, Ordering::SeqCst, Ordering::SeqCst)
+            .is_ok();
+        if swapped {
+            self.notify();
+        }
+        swapped
+    }
+
+    fn notify(&self) {
+        // A sleeper counts itself before it last looks at the state, both sequentially
+        // consistent: either it sees the new state or it is counted here.
+        if self.sleepers.load(Ordering::SeqCst) > 0 {
+            drop(lock(&self.lock));
+            self.wake.notify_all();
+        }
+    }
+
+    /// Wait until the state satisfies `done`, returning it: spinning a few
+    /// microseconds, then asleep.
+    fn until(&self, done: impl Fn(u8) -> bool) -> u8 {
+        for _ in 0..SPINS {
+            let s = self.load();
+            if done(s) {
+                return s;
+            }
+            std::hint::spin_loop();
+        }
+        let mut guard = lock(&self.lock);
+        self.sleepers.fetch_add(1, Ordering::SeqCst);
+        let s = loop {
+            let s = self.load();
+            if done(s) {
+                break s;
+            }
+            guard = self
+                .wake
+                .wait(guard)
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+        };
+        self.sleepers.fetch_sub(1, Ordering::SeqCst);
+        s
+    }
+}
+
+/// Looks at the state before sleeping: a few microseconds, about the gap between two
+/// jobs of a sweep that is not waiting on the other side.
+const SPINS: u32 = 1 << 11;
 
 const IDLE: u8 = 0;
 const POSTED: u8 = 1;
@@ -77,14 +158,14 @@ impl<J, R> Partner<J, R> {
     /// Hand the partner `job` (the last one's result must have been taken).
     pub fn send(&self, job: J) {
         *lock(&self.job) = Some(job);
-        self.state.store(POSTED, Ordering::Release);
+        self.state.store(POSTED);
     }
 
     /// The result of the job last sent, once the partner has it.
     pub fn wait(&self) -> R {
-        let state = spin_until(&self.state, |s| s == DONE || s == DEAD);
+        let state = self.state.until(|s| s == DONE || s == DEAD);
         assert!(state == DONE, "the partner thread panicked");
-        self.state.store(IDLE, Ordering::Relaxed);
+        self.state.state.store(IDLE, Ordering::SeqCst);
         lock(&self.result)
             .take()
             .expect("a finished job leaves its result")
@@ -98,15 +179,15 @@ pub fn with_partner<J: Send, R: Send, T>(
     body: impl FnOnce(&Partner<J, R>) -> T,
 ) -> T {
     let partner = Partner {
-        state: AtomicU8::new(IDLE),
+        state: Signal::new(),
         job: Mutex::new(None),
         result: Mutex::new(None),
     };
     /// Tells the other side this side is gone, however it leaves.
-    struct Leave<'a>(&'a AtomicU8, u8);
+    struct Leave<'a>(&'a Signal, u8);
     impl Drop for Leave<'_> {
         fn drop(&mut self) {
-            self.0.store(self.1, Ordering::Release);
+            self.0.store(self.1);
         }
     }
     std::thread::scope(|scope| {
@@ -114,7 +195,7 @@ pub fn with_partner<J: Send, R: Send, T>(
         scope.spawn(move || {
             let dead = Leave(&p.state, DEAD);
             loop {
-                if spin_until(&p.state, |s| s == POSTED || s == QUIT) == QUIT {
+                if p.state.until(|s| s == POSTED || s == QUIT) == QUIT {
                     // Not dead: it left as asked.
                     std::mem::forget(dead);
                     return;
@@ -123,10 +204,7 @@ pub fn with_partner<J: Send, R: Send, T>(
                 let result = work(job);
                 *lock(&p.result) = Some(result);
                 // The caller may have left meanwhile (unwinding): then so does the partner.
-                if (p.state)
-                    .compare_exchange(POSTED, DONE, Ordering::AcqRel, Ordering::Acquire)
-                    .is_err()
-                {
+                if !p.state.swap_from(POSTED, DONE) {
                     std::mem::forget(dead);
                     return;
                 }
@@ -135,24 +213,6 @@ pub fn with_partner<J: Send, R: Send, T>(
         let _quit = Leave(&partner.state, QUIT);
         body(&partner)
     })
-}
-
-/// Wait until `state` satisfies `done`, returning it: spinning at first, then yielding
-/// the core between looks.
-fn spin_until(state: &AtomicU8, done: impl Fn(u8) -> bool) -> u8 {
-    let mut spins = 0u32;
-    loop {
-        let s = state.load(Ordering::Acquire);
-        if done(s) {
-            return s;
-        }
-        if spins < 1 << 14 {
-            spins += 1;
-            std::hint::spin_loop();
-        } else {
-            std::thread::yield_now();
-        }
-    }
 }
 
 /// The guarded value, whether or not a holder panicked.
@@ -185,6 +245,29 @@ mod tests {
         );
         assert_eq!(total, (1..=100u64).map(|x| x * x).sum::<u64>());
         assert_eq!(seen, (1..=100).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn both_sides_sleep_through_long_waits_and_are_woken() {
+        // Jobs far longer than the spin, and gaps between jobs as long: each side ends
+        // up asleep waiting for the other.
+        let pause = std::time::Duration::from_millis(3);
+        let total = with_partner(
+            |x: u32| {
+                std::thread::sleep(pause);
+                x + 1
+            },
+            |partner| {
+                let mut total = 0;
+                for x in 0..5 {
+                    std::thread::sleep(pause);
+                    partner.send(x);
+                    total += partner.wait();
+                }
+                total
+            },
+        );
+        assert_eq!(total, 15);
     }
 
     #[test]
