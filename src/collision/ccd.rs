@@ -45,6 +45,21 @@ pub fn point_edge_time_of_impact(
     r: DVec2,
     dr: DVec2,
 ) -> Option<PointEdgeHit> {
+    if !boxes_meet(p, dp, q, dq, r, dr) {
+        return None;
+    }
+    time_of_impact(p, dp, q, dq, r, dr)
+}
+
+/// [`point_edge_time_of_impact`] past the boxes' test.
+fn time_of_impact(
+    p: DVec2,
+    dp: DVec2,
+    q: DVec2,
+    dq: DVec2,
+    r: DVec2,
+    dr: DVec2,
+) -> Option<PointEdgeHit> {
     let (a0, a1) = (q - p, dq - dp);
     let (b0, b1) = (r - p, dr - dp);
     let quadratic = a1.perp_dot(b1);
@@ -115,6 +130,18 @@ pub fn point_edge_time_of_impact(
         });
     }
     None
+}
+
+/// Whether the box of the point's path meets the box of the edge's sweep, widened by
+/// far more than the tolerances above: a point that never enters the edge's box
+/// cannot touch it. Most pairs a broad phase hands over (boxes widened by a
+/// thickness) end here, before the quadratic.
+fn boxes_meet(p: DVec2, dp: DVec2, q: DVec2, dq: DVec2, r: DVec2, dr: DVec2) -> bool {
+    let (p1, q1, r1) = (p + dp, q + dq, r + dr);
+    let (low, high) = (p.min(p1), p.max(p1));
+    let (edge_low, edge_high) = (q.min(q1).min(r).min(r1), q.max(q1).max(r).max(r1));
+    let slack = 1e-9 * ((high - low) + (edge_high - edge_low)).max_element();
+    low.cmple(edge_high + slack).all() && edge_low.cmple(high + slack).all()
 }
 
 /// The contact at time `t`, if p then lies on the edge (α in [0, 1] up to tolerance).
@@ -348,6 +375,33 @@ mod tests {
             previous = now;
         }
         None
+    }
+
+    #[test]
+    fn pairs_whose_boxes_miss_have_no_contact() {
+        // Points that pass just outside the edge's box, grazing its corners and
+        // sides, or meet it: the boxes' test never turns away a pair the roots touch.
+        let mut rng = StdRng::seed_from_u64(11);
+        let v =
+            |rng: &mut StdRng, s: f64| DVec2::new(rng.random_range(-s..s), rng.random_range(-s..s));
+        let (mut missed, mut touching) = (0, 0);
+        for case in 0..200_000 {
+            let q = v(&mut rng, 1.0);
+            let r = q + v(&mut rng, 0.6);
+            let (dq, dr) = (v(&mut rng, 0.1), v(&mut rng, 0.1));
+            // Start at an end of the edge or of its sweep, offset by a hair or by a lot.
+            let corner = [q, r, q + dq, r + dr][case % 4];
+            let offset = 10f64.powi(-((case % 13) as i32));
+            let p = corner + v(&mut rng, offset);
+            let dp = [DVec2::ZERO, v(&mut rng, offset), v(&mut rng, 1.0)][case % 3];
+            let touches = time_of_impact(p, dp, q, dq, r, dr);
+            if !boxes_meet(p, dp, q, dq, r, dr) {
+                missed += 1;
+                assert_eq!(touches, None, "case {case}");
+            }
+            touching += usize::from(touches.is_some());
+        }
+        assert!(missed > 10_000 && touching > 10_000, "{missed} {touching}");
     }
 
     #[test]
