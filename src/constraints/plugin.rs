@@ -4,6 +4,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+mod active_rows;
 mod joint_driver;
 
 use super::islands::{IslandKind, IslandSet, find_islands};
@@ -20,6 +21,7 @@ use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::topology::{Topology, rebuild_topology};
+use active_rows::ActiveRows;
 use joint_driver::JointDriver;
 
 /// The islands of the current topology and the solver's reusable buffers.
@@ -37,6 +39,7 @@ pub struct Islands {
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
     joint: JointDriver,
+    active: ActiveRows,
     lanes: Vec<Lane>,
     /// Each topology edge's impulse this step, summed over every projection of the
     /// step (mass × length, tension positive): see [`Islands::edge_tension`].
@@ -236,6 +239,42 @@ impl Islands {
             stats,
             outcomes,
             &mut self.impulse,
+        )
+    }
+
+    /// [`Islands::project_jointly`] over the rows that act: those warm-started or
+    /// within `margin` (a distance over the step) of their target at the start, their
+    /// neighbours, and any the projection leaves short (then projected again from the
+    /// same start). For islands the Constrain stage has just met, where most rows
+    /// within reach never push; a row left out ends with no impulse.
+    #[allow(clippy::too_many_arguments)]
+    pub fn project_active_rows(
+        &mut self,
+        island: &[u32],
+        bodies: &mut Bodies,
+        rows: &[ContactRow],
+        impulses: &mut [RowImpulse],
+        dt: f64,
+        settings: &JointSettings,
+        stats: &mut IterationStats,
+        outcomes: &mut Vec<(u32, bool)>,
+        threads: usize,
+        margin: f64,
+    ) -> JointOutcome {
+        self.active.project(
+            &mut self.joint,
+            &self.set,
+            island,
+            bodies,
+            rows,
+            impulses,
+            dt,
+            settings,
+            threads,
+            stats,
+            outcomes,
+            &mut self.impulse,
+            margin,
         )
     }
 
