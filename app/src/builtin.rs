@@ -45,6 +45,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/furry_creature.ron"),
     },
     BuiltinScene {
+        name: "furry_creature_stiff",
+        file: "assets/scenes/furry_creature_stiff.ron",
+        text: include_str!("../../assets/scenes/furry_creature_stiff.ron"),
+    },
+    BuiltinScene {
         name: "furry_creature_2000",
         file: "assets/scenes/furry_creature_2000.ron",
         text: include_str!("../../assets/scenes/furry_creature_2000.ron"),

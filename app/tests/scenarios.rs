@@ -368,6 +368,15 @@ fn bad_command_lines_are_refused_with_a_message() {
 }
 
 #[test]
+fn stiff_fur_is_bent_implicitly_and_keeps_its_hairs_exact() {
+    let report = run_ok(&options("furry_creature_stiff", 0.05));
+    assert_eq!(report.config["step"]["bending"], "quadratic");
+    assert_eq!(report.strands, 401);
+    assert!(report.max_rel_length_error < 1e-12);
+    assert_eq!(report.edge_crossings, Some(0));
+}
+
+#[test]
 fn list_and_json_output() {
     let (ok, out, _) = strands_command(&["list"]);
     assert!(ok);
