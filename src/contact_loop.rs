@@ -73,9 +73,9 @@ fn joint_settings(
 
 /// A speculative row acts from the start of its solve when it is within this many
 /// thicknesses of its target (or carries a warm start): rows farther clear, most of a
-/// fur's, are checked after the solve instead of joining its groups. Half the cushion:
-/// at zero, the fur's resting rows were left out only to be taken in again, its
-/// solve run twice in one step in six.
+/// stiff fur's, are checked after the solve instead of joining its groups. Half the
+/// cushion: at zero, the limp fur's resting rows were left out only to be taken in
+/// again, a second round in one solve in eight (none in 300 steps at half).
 const ACTING_MARGIN: f64 = 0.5;
 
 /// The contact rows of the latest joint projection and the impulses they carried,
