@@ -162,6 +162,7 @@ pub fn speculate(
             friction: collisions.friction,
             down: step.gravity.normalize_or_zero(),
         },
+        collider.settings.threads,
         &mut buffers.speculation,
         &mut buffers.rows,
         &mut buffers.keys,

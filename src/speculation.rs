@@ -11,6 +11,7 @@ use bevy::math::DVec2;
 use crate::constraints::projection::ContactRow;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
+use crate::parallel::run_each;
 
 /// What the rows of a step ask.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,7 +37,21 @@ pub struct SpeculationScratch {
     candidates: Vec<Candidate>,
     /// Each point's pairs (first, end) with its height.
     points: Vec<(f64, u32, u32)>,
+    /// The other threads' buffers.
+    lanes: Vec<Lane>,
 }
+
+/// One other thread's candidates, rows and keys.
+#[derive(Clone, Debug, Default)]
+struct Lane {
+    candidates: Vec<Candidate>,
+    rows: Vec<ContactRow>,
+    keys: Vec<(u32, u32, u32)>,
+}
+
+/// Below this many points with pairs the rows are built on one thread: a point's rows
+/// take a fraction of a microsecond, starting a thread tens.
+const PARALLEL_POINTS: usize = 2048;
 
 /// A key's second half for a row that is not its point's nearest on its strand: the
 /// edge, with this bit set (the nearest row of a strand is keyed by the strand).
@@ -59,10 +74,11 @@ const CORNER_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// The rows of the step for `pairs` (point, edge), grouped by point as the broad phase
 /// gives them, the lowest point's first. For each point and each strand within reach,
-/// the nearest edge gives
-/// one row; another edge of that strand gives one only in a corner. Each row's key is
-/// (point, strand) or (point, [`EDGE_KEY`] | edge), for warm starts, followed by its
-/// edge.
+/// the nearest edge gives one row; another edge of that strand gives one only in a
+/// corner. Each row's key is (point, strand) or (point, [`EDGE_KEY`] | edge), for warm
+/// starts, followed by its edge. With `threads` above one and enough points, runs of
+/// points are built on that many threads and their rows appended in order: the same
+/// rows whatever the count.
 #[allow(clippy::too_many_arguments)]
 pub fn speculative_rows(
     pairs: &[(u32, u32)],
@@ -71,13 +87,18 @@ pub fn speculative_rows(
     velocity: &[DVec2],
     dt: f64,
     settings: &SpeculationSettings,
+    threads: usize,
     scratch: &mut SpeculationScratch,
     rows: &mut Vec<ContactRow>,
     keys: &mut Vec<(u32, u32, u32)>,
 ) {
     rows.clear();
     keys.clear();
-    let SpeculationScratch { candidates, points } = scratch;
+    let SpeculationScratch {
+        candidates,
+        points,
+        lanes,
+    } = scratch;
     points.clear();
     let mut start = 0;
     while start < pairs.len() {
@@ -88,76 +109,135 @@ pub fn speculative_rows(
         start = end;
     }
     points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    for &(_, start, end) in points.iter() {
-        let (start, end) = (start as usize, end as usize);
-        let p = pairs[start].0;
-        candidates.clear();
-        for &(_, k) in &pairs[start..end] {
-            let e = &edges[k as usize];
-            let (q, r, x) = (
-                position[e.a as usize],
-                position[e.b as usize],
-                position[p as usize],
+    let build = |run: &[(f64, u32, u32)],
+                 candidates: &mut Vec<Candidate>,
+                 rows: &mut Vec<ContactRow>,
+                 keys: &mut Vec<(u32, u32, u32)>| {
+        for &(_, start, end) in run {
+            let pairs = &pairs[start as usize..end as usize];
+            point_rows(
+                pairs, edges, position, velocity, dt, settings, candidates, rows, keys,
             );
-            let (alpha, gap) = closest_on_segment(x, q, r);
-            if gap <= 0.0 {
-                continue; // on the edge: the collision stage decides its side
-            }
-            let normal = (x - q.lerp(r, alpha)) / gap;
-            let relative =
-                velocity[p as usize] - velocity[e.a as usize].lerp(velocity[e.b as usize], alpha);
-            if gap.min(gap + dt * normal.dot(relative)) >= settings.reach {
-                continue; // starts and would end the step out of reach
-            }
-            candidates.push(Candidate {
-                edge: k,
-                strand: e.strand,
-                alpha,
-                gap,
-                normal,
-            });
         }
-        candidates
-            .sort_unstable_by(|a, b| (a.strand, a.gap).partial_cmp(&(b.strand, b.gap)).unwrap());
-        let mut first = 0;
-        while first < candidates.len() {
-            let strand = candidates[first].strand;
-            let last = first
-                + candidates[first..]
-                    .iter()
-                    .take_while(|c| c.strand == strand)
-                    .count();
-            for i in first..last {
-                let c = candidates[i];
-                let corner = candidates[first..i]
-                    .iter()
-                    .all(|kept| kept.normal.dot(c.normal) < CORNER_COS);
-                if i > first && !corner {
-                    continue;
-                }
-                let e = &edges[c.edge as usize];
-                let pair = PointEdgePair {
-                    p: p as usize,
-                    q: e.a as usize,
-                    r: e.b as usize,
-                    alpha: c.alpha,
-                };
-                let mut row = ContactRow::point_edge(pair, c.normal, velocity);
-                row.target = target(c.gap, settings, dt);
-                row.friction = settings.friction;
-                rows.push(row);
-                keys.push((
-                    p,
-                    if i == first {
-                        strand
-                    } else {
-                        EDGE_KEY | c.edge
-                    },
-                    c.edge,
-                ));
-            }
-            first = last;
+    };
+    let threads = if points.len() >= PARALLEL_POINTS {
+        threads.max(1)
+    } else {
+        1
+    };
+    if threads == 1 {
+        build(points, candidates, rows, keys);
+        return;
+    }
+    lanes.resize_with(threads - 1, Default::default);
+    let n = points.len();
+    let mut parts = vec![(&points[..n / threads], candidates, &mut *rows, &mut *keys)];
+    for (
+        t,
+        Lane {
+            candidates,
+            rows,
+            keys,
+        },
+    ) in lanes.iter_mut().enumerate()
+    {
+        rows.clear();
+        keys.clear();
+        parts.push((
+            &points[n * (t + 1) / threads..n * (t + 2) / threads],
+            candidates,
+            rows,
+            keys,
+        ));
+    }
+    run_each(parts, |_, (run, candidates, rows, keys)| {
+        build(run, candidates, rows, keys)
+    });
+    for lane in lanes.iter() {
+        rows.extend_from_slice(&lane.rows);
+        keys.extend_from_slice(&lane.keys);
+    }
+}
+
+/// The rows of one point, from its `pairs`.
+#[allow(clippy::too_many_arguments)]
+fn point_rows(
+    pairs: &[(u32, u32)],
+    edges: &[Edge],
+    position: &[DVec2],
+    velocity: &[DVec2],
+    dt: f64,
+    settings: &SpeculationSettings,
+    candidates: &mut Vec<Candidate>,
+    rows: &mut Vec<ContactRow>,
+    keys: &mut Vec<(u32, u32, u32)>,
+) {
+    let p = pairs[0].0;
+    candidates.clear();
+    for &(_, k) in pairs {
+        let e = &edges[k as usize];
+        let (q, r, x) = (
+            position[e.a as usize],
+            position[e.b as usize],
+            position[p as usize],
+        );
+        let (alpha, gap) = closest_on_segment(x, q, r);
+        if gap <= 0.0 {
+            continue; // on the edge: the collision stage decides its side
         }
+        let normal = (x - q.lerp(r, alpha)) / gap;
+        let relative =
+            velocity[p as usize] - velocity[e.a as usize].lerp(velocity[e.b as usize], alpha);
+        if gap.min(gap + dt * normal.dot(relative)) >= settings.reach {
+            continue; // starts and would end the step out of reach
+        }
+        candidates.push(Candidate {
+            edge: k,
+            strand: e.strand,
+            alpha,
+            gap,
+            normal,
+        });
+    }
+    candidates.sort_unstable_by(|a, b| a.strand.cmp(&b.strand).then(a.gap.total_cmp(&b.gap)));
+    let mut first = 0;
+    while first < candidates.len() {
+        let strand = candidates[first].strand;
+        let last = first
+            + candidates[first..]
+                .iter()
+                .take_while(|c| c.strand == strand)
+                .count();
+        for i in first..last {
+            let c = candidates[i];
+            let corner = candidates[first..i]
+                .iter()
+                .all(|kept| kept.normal.dot(c.normal) < CORNER_COS);
+            if i > first && !corner {
+                continue;
+            }
+            let e = &edges[c.edge as usize];
+            let pair = PointEdgePair {
+                p: p as usize,
+                q: e.a as usize,
+                r: e.b as usize,
+                alpha: c.alpha,
+            };
+            let mut row = ContactRow::point_edge(pair, c.normal, velocity);
+            row.target = target(c.gap, settings, dt);
+            row.friction = settings.friction;
+            rows.push(row);
+            keys.push((
+                p,
+                if i == first {
+                    strand
+                } else {
+                    EDGE_KEY | c.edge
+                },
+                c.edge,
+            ));
+        }
+        first = last;
     }
 }
 
@@ -210,11 +290,64 @@ mod tests {
             velocity,
             0.01,
             &settings(),
+            1,
             &mut SpeculationScratch::default(),
             &mut rows,
             &mut keys,
         );
         (rows, keys)
+    }
+
+    #[test]
+    fn two_threads_build_the_rows_of_one() {
+        // 3 000 points each over its own strand's edge (most within reach), and paired with
+        // the next strand's edge too (out of reach), given in point order.
+        let (mut position, mut edges, mut pairs) = (Vec::new(), Vec::new(), Vec::new());
+        let velocity: Vec<DVec2> = (0..9000)
+            .map(|i| DVec2::new(0.0, -0.1 * (i % 7) as f64))
+            .collect();
+        for i in 0..3000u32 {
+            let x = 0.03 * i as f64;
+            let tilt = 0.001 * (i % 5) as f64;
+            position.extend([
+                DVec2::new(x + 0.001 * (i % 3) as f64, 0.001 * (i % 11) as f64),
+                DVec2::new(x - 0.01, -0.004),
+                DVec2::new(x + 0.01, -0.003 + tilt),
+            ]);
+        }
+        for i in 0..3000u32 {
+            edges.push(edge(3 * i + 1, 3 * i + 2, i, &position));
+        }
+        for i in 0..3000u32 {
+            pairs.push((3 * i, i));
+            if i + 1 < 3000 {
+                pairs.push((3 * i, i + 1));
+            }
+        }
+        let build = |threads| {
+            let (mut rows, mut keys) = (Vec::new(), Vec::new());
+            let mut scratch = SpeculationScratch::default();
+            // Twice with the same buffers: the lanes' rows from the first are not kept.
+            for _ in 0..2 {
+                speculative_rows(
+                    &pairs,
+                    &edges,
+                    &position,
+                    &velocity,
+                    0.01,
+                    &settings(),
+                    threads,
+                    &mut scratch,
+                    &mut rows,
+                    &mut keys,
+                );
+            }
+            (rows, keys)
+        };
+        let one = build(1);
+        assert!(one.0.len() > 1500, "{}", one.0.len());
+        assert_eq!(build(2), one);
+        assert_eq!(build(3), one);
     }
 
     #[test]
