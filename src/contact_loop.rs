@@ -177,7 +177,7 @@ pub fn speculate(
         return;
     }
     let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
-    islands.project_active_rows(
+    islands.project_jointly(
         collider.groups,
         &mut bodies,
         &buffers.rows,
@@ -187,7 +187,7 @@ pub fn speculate(
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
         collider.settings.threads,
-        ACTING_MARGIN * thickness,
+        Some(ACTING_MARGIN * thickness),
     );
     // Remember the impulses for the next step's rows of the same pairs, and the
     // contacts that took one.
@@ -356,6 +356,8 @@ fn reproject(
         &mut metrics.contact_projection,
         &mut buffers.outcomes,
         collider.settings.threads,
+        // Every row: impulses left these islands stretched, so all must be projected.
+        None,
     );
     for &(island, met) in &buffers.outcomes {
         collider.scratch.projected(island, met);

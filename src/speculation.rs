@@ -132,23 +132,11 @@ pub fn speculative_rows(
     lanes.resize_with(threads - 1, Default::default);
     let n = points.len();
     let mut parts = vec![(&points[..n / threads], candidates, &mut *rows, &mut *keys)];
-    for (
-        t,
-        Lane {
-            candidates,
-            rows,
-            keys,
-        },
-    ) in lanes.iter_mut().enumerate()
-    {
-        rows.clear();
-        keys.clear();
-        parts.push((
-            &points[n * (t + 1) / threads..n * (t + 2) / threads],
-            candidates,
-            rows,
-            keys,
-        ));
+    for (t, lane) in lanes.iter_mut().enumerate() {
+        lane.rows.clear();
+        lane.keys.clear();
+        let run = &points[n * (t + 1) / threads..n * (t + 2) / threads];
+        parts.push((run, &mut lane.candidates, &mut lane.rows, &mut lane.keys));
     }
     run_each(parts, |_, (run, candidates, rows, keys)| {
         build(run, candidates, rows, keys)

@@ -210,10 +210,15 @@ impl Islands {
     /// Project jointly every island that `rows` touch, and the loose free particles
     /// they touch, with the rows: both sides of every contact move, each island as a
     /// whole (see [`project_jointly`](super::projection::project_jointly)), each
-    /// independent group on its own and on up to `threads` threads. `island` gives each particle's island, as
-    /// [`Topology::island`] does; `impulses[c]` is row c's warm start on entry and its
-    /// total impulse on return. `outcomes` tells, for each island projected, whether
-    /// it met its edges.
+    /// independent group on its own and on up to `threads` threads. `island` gives each
+    /// particle's island, as [`Topology::island`] does; `impulses[c]` is row c's warm
+    /// start on entry and its total impulse on return. `outcomes` tells, for each
+    /// island projected, whether it met its edges. With `acting: Some(margin)` only the
+    /// rows that act are projected: those warm-started or within `margin` (a distance
+    /// over the step) of their target at the start, their neighbours, and any the
+    /// projection leaves short (then projected again from the same start) — for islands
+    /// the Constrain stage has just met, where most rows within reach never push; a row
+    /// left out ends with no impulse. `None`: every row.
     #[allow(clippy::too_many_arguments)]
     pub fn project_jointly(
         &mut self,
@@ -226,40 +231,7 @@ impl Islands {
         stats: &mut IterationStats,
         outcomes: &mut Vec<(u32, bool)>,
         threads: usize,
-    ) -> JointOutcome {
-        self.joint.project(
-            &self.set,
-            island,
-            bodies,
-            rows,
-            impulses,
-            dt,
-            settings,
-            threads,
-            stats,
-            outcomes,
-            &mut self.impulse,
-        )
-    }
-
-    /// [`Islands::project_jointly`] over the rows that act: those warm-started or
-    /// within `margin` (a distance over the step) of their target at the start, their
-    /// neighbours, and any the projection leaves short (then projected again from the
-    /// same start). For islands the Constrain stage has just met, where most rows
-    /// within reach never push; a row left out ends with no impulse.
-    #[allow(clippy::too_many_arguments)]
-    pub fn project_active_rows(
-        &mut self,
-        island: &[u32],
-        bodies: &mut Bodies,
-        rows: &[ContactRow],
-        impulses: &mut [RowImpulse],
-        dt: f64,
-        settings: &JointSettings,
-        stats: &mut IterationStats,
-        outcomes: &mut Vec<(u32, bool)>,
-        threads: usize,
-        margin: f64,
+        acting: Option<f64>,
     ) -> JointOutcome {
         self.active.project(
             &mut self.joint,
@@ -274,7 +246,7 @@ impl Islands {
             stats,
             outcomes,
             &mut self.impulse,
-            margin,
+            acting,
         )
     }
 

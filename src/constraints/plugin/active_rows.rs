@@ -144,7 +144,8 @@ impl ActiveRows {
     /// [`JointDriver::project`] over the rows that act: `rows` and `impulses` as there
     /// (a row left out ends with no impulse); the islands projected are those the
     /// acting rows touch. A row acts from the start when it is warm-started or clear of
-    /// its target by less than `margin` (a distance over the step).
+    /// its target by less than `margin` (a distance over the step); with no margin,
+    /// every row acts.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn project(
         &mut self,
@@ -160,15 +161,18 @@ impl ActiveRows {
         stats: &mut IterationStats,
         outcomes: &mut Vec<(u32, bool)>,
         edge_impulse: &mut [f64],
-        margin: f64,
+        margin: Option<f64>,
     ) -> JointOutcome {
-        self.live.clear();
-        self.live.extend(rows.iter().enumerate().map(|(c, row)| {
-            impulses.get(c).is_some_and(|i| *i != RowImpulse::default())
-                || shortfall(row, bodies.velocity, dt) > -margin
-        }));
-        self.take_in_neighbours(set.islands.len(), island, bodies.inverse_mass, rows);
-        if self.live.iter().all(|&l| l) {
+        let every_row = margin.is_none_or(|margin| {
+            self.live.clear();
+            self.live.extend(rows.iter().enumerate().map(|(c, row)| {
+                impulses.get(c).is_some_and(|i| *i != RowImpulse::default())
+                    || shortfall(row, bodies.velocity, dt) > -margin
+            }));
+            self.take_in_neighbours(set.islands.len(), island, bodies.inverse_mass, rows);
+            self.live.iter().all(|&l| l)
+        });
+        if every_row {
             return driver.project(
                 set,
                 island,
@@ -347,36 +351,21 @@ mod tests {
             let mut stats = IterationStats::default();
             let (set, island, rows, settings) =
                 (&self.set, &self.island, &self.rows, &Self::settings());
-            let outcome = match margin {
-                Some(margin) => ActiveRows::default().project(
-                    &mut driver,
-                    set,
-                    island,
-                    &mut bodies,
-                    rows,
-                    &mut impulses,
-                    DT,
-                    settings,
-                    1,
-                    &mut stats,
-                    &mut outcomes,
-                    &mut edge_impulse,
-                    margin,
-                ),
-                None => driver.project(
-                    set,
-                    island,
-                    &mut bodies,
-                    rows,
-                    &mut impulses,
-                    DT,
-                    settings,
-                    1,
-                    &mut stats,
-                    &mut outcomes,
-                    &mut edge_impulse,
-                ),
-            };
+            let outcome = ActiveRows::default().project(
+                &mut driver,
+                set,
+                island,
+                &mut bodies,
+                rows,
+                &mut impulses,
+                DT,
+                settings,
+                1,
+                &mut stats,
+                &mut outcomes,
+                &mut edge_impulse,
+                margin,
+            );
             assert!(outcome.converged, "{outcome:?}");
             (impulses, outcomes)
         }
