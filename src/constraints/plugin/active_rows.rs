@@ -141,6 +141,27 @@ impl ActiveRows {
         }
     }
 
+    /// Mark live the rows that act from the start: warm-started, or clear of their
+    /// target by less than `margin`, and their neighbours.
+    #[allow(clippy::too_many_arguments)]
+    fn mark_acting(
+        &mut self,
+        set: &IslandSet,
+        island: &[u32],
+        bodies: &Bodies,
+        rows: &[ContactRow],
+        impulses: &[RowImpulse],
+        dt: f64,
+        margin: f64,
+    ) {
+        self.live.clear();
+        self.live.extend(rows.iter().enumerate().map(|(c, row)| {
+            impulses.get(c).is_some_and(|i| *i != RowImpulse::default())
+                || shortfall(row, bodies.velocity, dt) > -margin
+        }));
+        self.take_in_neighbours(set.islands.len(), island, bodies.inverse_mass, rows);
+    }
+
     /// [`JointDriver::project`] over the rows that act: `rows` and `impulses` as there
     /// (a row left out ends with no impulse); the islands projected are those the
     /// acting rows touch. A row acts from the start when it is warm-started or clear of
@@ -163,15 +184,13 @@ impl ActiveRows {
         edge_impulse: &mut [f64],
         margin: Option<f64>,
     ) -> JointOutcome {
-        let every_row = margin.is_none_or(|margin| {
-            self.live.clear();
-            self.live.extend(rows.iter().enumerate().map(|(c, row)| {
-                impulses.get(c).is_some_and(|i| *i != RowImpulse::default())
-                    || shortfall(row, bodies.velocity, dt) > -margin
-            }));
-            self.take_in_neighbours(set.islands.len(), island, bodies.inverse_mass, rows);
-            self.live.iter().all(|&l| l)
-        });
+        let every_row = match margin {
+            None => true,
+            Some(margin) => {
+                self.mark_acting(set, island, bodies, rows, impulses, dt, margin);
+                self.live.iter().all(|&l| l)
+            }
+        };
         if every_row {
             return driver.project(
                 set,
