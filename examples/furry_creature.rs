@@ -1,4 +1,5 @@
-//! A body on a circular path drags 400 hairs rooted on its rim.
+//! A body on a circular path drags 400 stiff hairs rooted on its rim, one step of 1/60 s a
+//! tick.
 //!
 //! `cargo run --release --example furry_creature --features render`. The panel on the right
 //! holds the controls, the live figures and the mouse tools.

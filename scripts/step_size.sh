@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --quiet --release --bin strands
 scenarios=("$@")
-[ ${#scenarios[@]} -gt 0 ] || scenarios=(long_strand spaghetti_factory meatball_factory branches pile furry_creature scale sandbox)
+[ ${#scenarios[@]} -gt 0 ] || scenarios=(long_strand spaghetti_factory meatball_factory branches pile furry_creature furry_creature_limp scale sandbox)
 out=$(mktemp -d)
 for scenario in "${scenarios[@]}"; do
     for rate in 3000 1200 600 300 120 60; do

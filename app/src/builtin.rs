@@ -45,9 +45,9 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/furry_creature.ron"),
     },
     BuiltinScene {
-        name: "furry_creature_stiff",
-        file: "assets/scenes/furry_creature_stiff.ron",
-        text: include_str!("../../assets/scenes/furry_creature_stiff.ron"),
+        name: "furry_creature_limp",
+        file: "assets/scenes/furry_creature_limp.ron",
+        text: include_str!("../../assets/scenes/furry_creature_limp.ron"),
     },
     BuiltinScene {
         name: "furry_creature_2000",

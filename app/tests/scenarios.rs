@@ -210,11 +210,11 @@ fn a_drain_keeps_the_factory_pile_bounded_exact_and_uncrossed() {
 fn the_bending_model_is_chosen_from_the_command_line_and_named_in_the_report() {
     let quadratic = run_ok(&RunOptions {
         bending: Some("quadratic".into()),
-        ..options("furry_creature", 0.2)
+        ..options("furry_creature_limp", 0.2)
     });
     assert_eq!(quadratic.config["step"]["bending"], "quadratic");
     assert!(quadratic.max_rel_length_error < 1e-12);
-    let angle = run_ok(&options("furry_creature", 0.2));
+    let angle = run_ok(&options("furry_creature_limp", 0.2));
     assert_eq!(angle.config["step"]["bending"], "angle");
     // The same scene moved by another bending model: close, not the same.
     assert!((quadratic.max_speed_at_end - angle.max_speed_at_end).abs() < 0.5);
@@ -253,20 +253,25 @@ fn meatball_factory_drops_spinning_loops() {
 }
 
 #[test]
-fn furry_creature_keeps_its_hairs_exact() {
-    let report = run_ok(&options("furry_creature", 0.05));
-    // 400 hairs of 12 and the body's collision outline (a driven wall polygon).
-    assert_eq!(report.strands, 401);
-    assert!(report.particles > 4800 && report.particles < 4800 + 200);
-    // Each hair's first edge is between two driven particles: not constrained.
-    assert_eq!(report.constrained_edges, 400 * 10);
-    assert!(report.max_rel_length_error < 1e-12);
-    assert_eq!(report.edge_crossings, Some(0));
-    assert!(
-        !(report.notes.iter()).any(|n| n.contains("collisions are off")),
-        "{:?}",
-        report.notes
-    );
+fn furry_creatures_keep_their_hairs_exact() {
+    // The fur that stands out (stiff hair, bent implicitly, at a game's step) and the
+    // limp mat.
+    for (scenario, bending) in [("furry_creature", "quadratic"), ("furry_creature_limp", "angle")] {
+        let report = run_ok(&options(scenario, 0.05));
+        assert_eq!(report.config["step"]["bending"], bending, "{scenario}");
+        // 400 hairs of 12 and the body's collision outline (a driven wall polygon).
+        assert_eq!(report.strands, 401);
+        assert!(report.particles > 4800 && report.particles < 4800 + 200);
+        // Each hair's first edge is between two driven particles: not constrained.
+        assert_eq!(report.constrained_edges, 400 * 10);
+        assert!(report.max_rel_length_error < 1e-12, "{scenario}");
+        assert_eq!(report.edge_crossings, Some(0), "{scenario}");
+        assert!(
+            !(report.notes.iter()).any(|n| n.contains("collisions are off")),
+            "{:?}",
+            report.notes
+        );
+    }
 }
 
 #[test]
@@ -368,15 +373,6 @@ fn bad_command_lines_are_refused_with_a_message() {
 }
 
 #[test]
-fn stiff_fur_is_bent_implicitly_and_keeps_its_hairs_exact() {
-    let report = run_ok(&options("furry_creature_stiff", 0.05));
-    assert_eq!(report.config["step"]["bending"], "quadratic");
-    assert_eq!(report.strands, 401);
-    assert!(report.max_rel_length_error < 1e-12);
-    assert_eq!(report.edge_crossings, Some(0));
-}
-
-#[test]
 fn list_and_json_output() {
     let (ok, out, _) = strands_command(&["list"]);
     assert!(ok);
@@ -385,6 +381,7 @@ fn list_and_json_output() {
         "spaghetti_factory",
         "meatball_factory",
         "furry_creature",
+        "furry_creature_limp",
         "branches",
         "scale",
     ] {

@@ -46,7 +46,7 @@ fn a_run_continued_from_a_snapshot_ends_as_the_uninterrupted_run() {
     for (scenario, at, end) in [
         ("spaghetti_factory", 0.8, 1.5),
         ("meatball_factory", 1.0, 2.2),
-        ("furry_creature", 0.02, 0.05),
+        ("furry_creature_limp", 0.02, 0.05),
     ] {
         let whole = run_ok(&options(scenario, end));
         let file = scratch(&format!("{scenario}.ron"));
