@@ -256,7 +256,10 @@ fn meatball_factory_drops_spinning_loops() {
 fn furry_creatures_keep_their_hairs_exact() {
     // The fur that stands out (stiff hair, bent implicitly, at a game's step) and the
     // limp mat.
-    for (scenario, bending) in [("furry_creature", "quadratic"), ("furry_creature_limp", "angle")] {
+    for (scenario, bending) in [
+        ("furry_creature", "quadratic"),
+        ("furry_creature_limp", "angle"),
+    ] {
         let report = run_ok(&options(scenario, 0.05));
         assert_eq!(report.config["step"]["bending"], bending, "{scenario}");
         // 400 hairs of 12 and the body's collision outline (a driven wall polygon).
