@@ -1,9 +1,9 @@
 //! Criterion benchmark of the furry creature's ticks, one second into its run:
-//! `furry_creature` (hair that stands out, touching at the body's sides; a tick is one
-//! step of 1/60 s) and `furry_creature_limp` (limp hair lying in a mat, one dense
-//! contact problem; three steps of 1/300 s), on one and two threads. The run goes on from tick to tick, so each sample
-//! is a stretch of the same motion. Run with `cargo bench --bench fur`; results per
-//! machine are in `benches/RESULTS.md`.
+//! `furry_creature` (hair that stands out; a tick is one step of 1/60 s) and
+//! `furry_creature_limp` (limp hair lying in a mat, one dense contact problem; three
+//! steps of 1/300 s), on one and two threads. The run goes on from tick to tick, so
+//! each sample is a stretch of the same motion. Run with `cargo bench --bench fur`;
+//! results per machine are in `benches/RESULTS.md`.
 
 use std::time::Duration;
 
