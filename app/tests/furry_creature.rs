@@ -1,11 +1,15 @@
 //! The furry creature's hairs collide with its body: limp hairs that fall over the body
 //! drape on its collision outline (and never cross it), where without the outline they
-//! fall through the body.
+//! fall through the body. And at the scene's game step the roots keep their place and
+//! orientation on the moving body.
 
 use bevy::math::DVec2;
 use bevy_strands::prelude::*;
-use bevy_strands_app::fixtures::{checked_app, crossings, set_step, ticks};
-use bevy_strands_app::scenes::furry_creature::{FurryCreatureSpec, spawn_furry_creature};
+use bevy_strands_app::fixtures::{checked_app, crossings, set_step, tick, ticks};
+use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
+use bevy_strands_app::scenes::furry_creature::{
+    FurryCreature, FurryCreatureSpec, spawn_furry_creature,
+};
 
 const BODY_RADIUS: f64 = 0.1;
 const INSET: f64 = 0.003;
@@ -67,4 +71,38 @@ fn without_a_body_outline_limp_hairs_fall_through_the_body() {
     // Well inside where the outline would have stopped them.
     assert!(nearest < BODY_RADIUS - 5.0 * INSET, "{nearest}");
     assert!(error < 1e-12, "{error:e}");
+}
+
+#[test]
+fn at_a_game_step_each_root_and_first_edge_ride_the_moving_body_exactly() {
+    let options = RunOptions {
+        scenario: "furry_creature".into(),
+        ..Default::default()
+    };
+    let scenario = load_scenario(&options).expect("a built-in scene");
+    assert_eq!(scenario.step.dt, 1.0 / 60.0);
+    let mut app = headless_app(&scenario).expect("the scene spawns");
+    // A quarter turn of the body in 1/60 s steps, hairs swinging and landing.
+    for _ in 0..60 {
+        tick(&mut app);
+        let world = app.world_mut();
+        let time = world.resource::<SimulationClock>().time;
+        let mut creatures = world.query::<&FurryCreature>();
+        let creature = creatures.single(world).expect("one creature").clone();
+        let centre = creature.spec.body_centre(time);
+        // Two driven particles per hair, then the outline's.
+        assert!(creature.roots.len() > 2 * 400, "{}", creature.roots.len());
+        for &(particle, offset) in &creature.roots {
+            let at = world.get::<Position>(particle).expect("a particle").0;
+            // Where the body puts it, to round-off: the root's place, and with the
+            // second particle the first edge's direction.
+            assert!(
+                at.distance(centre + offset) < 1e-12,
+                "{particle:?} at {at} off {} at t = {time}",
+                centre + offset
+            );
+        }
+    }
+    let metrics = app.world().resource::<StrandMetrics>();
+    assert!(metrics.max_rel_length_error < 1e-12);
 }
