@@ -2,9 +2,9 @@
 # Bending stiffness against stable step size, for both bending models: the limp furry
 # creature (furry_creature_limp: 400 hairs of 12 particles, roots driven,
 # --no-collisions) with its bending stiffness multiplied by 1 to 10⁴, at steps from
-# 1/3000 s to 1/60 s, 2 simulated seconds each. A run is stable when it ends finite with no particle faster than
-# 5 m/s (the creature's hairs move at about 1 m/s) and every edge within 1e-9 of its
-# length; the table gives the fastest particle at the end (or "non-finite") and the
+# 1/3000 s to 1/60 s, 2 simulated seconds each. A run is stable when it ends finite
+# with no particle faster than 5 m/s (the creature's hairs move at about 1 m/s) and
+# every edge within 1e-9 of its length; the table gives the fastest particle at the end (or "non-finite") and the
 # largest relative length error. The projection may take 200 Newton iterations (the
 # default cap is 20): whipping hairs at the largest steps can need more than 20, and the
 # study is of the bending models, not of that cap.
