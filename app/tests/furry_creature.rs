@@ -5,8 +5,9 @@
 
 use bevy::math::DVec2;
 use bevy_strands::prelude::*;
-use bevy_strands_app::fixtures::{checked_app, crossings, set_step, tick, ticks};
-use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
+use bevy_strands_app::builtin::builtin;
+use bevy_strands_app::fixtures::{checked_app, crossings, position, set_step, tick, ticks};
+use bevy_strands_app::runner::headless_app;
 use bevy_strands_app::scenes::furry_creature::{
     FurryCreature, FurryCreatureSpec, spawn_furry_creature,
 };
@@ -75,25 +76,23 @@ fn without_a_body_outline_limp_hairs_fall_through_the_body() {
 
 #[test]
 fn at_a_game_step_each_root_and_first_edge_ride_the_moving_body_exactly() {
-    let options = RunOptions {
-        scenario: "furry_creature".into(),
-        ..Default::default()
-    };
-    let scenario = load_scenario(&options).expect("a built-in scene");
+    let scenario = (builtin("furry_creature").expect("a built-in scene"))
+        .scenario()
+        .expect("it parses");
     assert_eq!(scenario.step.dt, 1.0 / 60.0);
     let mut app = headless_app(&scenario).expect("the scene spawns");
     // A quarter turn of the body in 1/60 s steps, hairs swinging and landing.
     for _ in 0..60 {
         tick(&mut app);
+        let time = app.world().resource::<SimulationClock>().time;
         let world = app.world_mut();
-        let time = world.resource::<SimulationClock>().time;
         let mut creatures = world.query::<&FurryCreature>();
         let creature = creatures.single(world).expect("one creature").clone();
         let centre = creature.spec.body_centre(time);
         // Two driven particles per hair, then the outline's.
         assert!(creature.roots.len() > 2 * 400, "{}", creature.roots.len());
         for &(particle, offset) in &creature.roots {
-            let at = world.get::<Position>(particle).expect("a particle").0;
+            let at = position(&app, particle);
             // Where the body puts it, to round-off: the root's place, and with the
             // second particle the first edge's direction.
             assert!(
