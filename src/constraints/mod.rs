@@ -13,6 +13,7 @@ pub mod graph;
 pub mod island_edge;
 pub mod islands;
 pub mod joint_groups;
+pub mod ldl;
 pub mod plugin;
 pub mod projection;
 pub mod relaxation;
