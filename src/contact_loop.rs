@@ -68,6 +68,7 @@ fn joint_settings(
         // At most the budget itself: the product cannot overflow in u64.
         rows_give_way: (u64::from(constraints.max_iterations) * u64::from(give_way.0)
             / u64::from(give_way.1.max(1))) as u32,
+        solver: contact.solver,
     }
 }
 

@@ -45,6 +45,8 @@ pub struct RunOptions {
     pub solver: Option<String>,
     /// Bending model, instead of the scene's.
     pub bending: Option<String>,
+    /// Contact solver, instead of the scene's.
+    pub contact_solver: Option<String>,
     /// Projection iteration cap, instead of the scene's.
     pub iterations: Option<u32>,
     /// Keep stretch springs on constrained edges.
@@ -158,6 +160,11 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
     }
     if let Some(bending) = &options.bending {
         scenario.step.bending = bending.parse().map_err(|e| command_line("--bending", e))?;
+    }
+    if let Some(solver) = &options.contact_solver {
+        scenario.contact.solver = solver
+            .parse()
+            .map_err(|e| command_line("--contact-solver", e))?;
     }
     if let Some(iterations) = options.iterations {
         scenario.constraints.max_iterations = iterations;

@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::collision::broad_phase::BroadPhaseMethod;
-use crate::constraints::projection::{ConstraintDirection, ProjectionSettings};
+use crate::constraints::projection::{ConstraintDirection, ContactSolver, ProjectionSettings};
 use crate::constraints::solver::SolverKind;
 use crate::model::validate::{
     NumberError, at_least, finite_vector, non_negative, positive, within,
@@ -396,6 +396,10 @@ pub struct ContactConfig {
     /// moving, rather than by impulses. Off, proximity and collision impulses do the
     /// work and the contact loop re-projects what they stretched.
     pub speculative: bool,
+    /// How a joint projection finds its rows' impulses: Newton's method on the rows
+    /// and edges together (the default), or projected Gauss–Seidel over each row's
+    /// response on its whole strands (the earlier design, a baseline).
+    pub solver: ContactSolver,
 }
 
 impl Default for ContactConfig {
@@ -408,6 +412,7 @@ impl Default for ContactConfig {
             keep: 0.5,
             reach: 2.0,
             speculative: true,
+            solver: ContactSolver::Auto,
         }
     }
 }

@@ -55,6 +55,11 @@ struct RunArgs {
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
+    /// Contact solver (default: the scene's): `newton` (rows and edges together, one
+    /// sparse factorization a Newton step) or `gauss-seidel` (sweeps over each row's
+    /// response on its whole strands, the earlier design).
+    #[arg(long, value_name = "NAME")]
+    contact_solver: Option<String>,
     /// Bending model (default: the scene's): `angle` (turning angle, explicit) or
     /// `quadratic` (isometric quadratic, implicit).
     #[arg(long, value_name = "MODEL")]
@@ -160,6 +165,7 @@ fn main() -> ExitCode {
                 threads: args.threads,
                 solver: args.solver,
                 bending: args.bending,
+                contact_solver: args.contact_solver,
                 iterations: args.iterations,
                 stretch_springs: args.stretch_springs,
                 start_of_step: args.start_of_step,

@@ -356,6 +356,7 @@ mod tests {
                 contact_tolerance: TOLERANCE,
                 max_correction: f64::INFINITY,
                 rows_give_way: 15,
+                solver: Default::default(),
             }
         }
 

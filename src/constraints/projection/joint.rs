@@ -30,7 +30,7 @@ use super::joint_rows::{Sweeps, localize_rows};
 use super::joint_split::Members;
 use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part};
 use super::scratch::Factors;
-use super::settings::{ConstraintDirection, ProjectionSettings, ROUND_OFF_FLOOR};
+use super::settings::{ConstraintDirection, ContactSolver, ProjectionSettings, ROUND_OFF_FLOOR};
 use super::view::{Bodies, IslandView};
 use super::walk::{ChainWalk, GraphWalk, Walk};
 use crate::constraints::island_edge::IslandEdge;
@@ -54,6 +54,8 @@ pub struct JointSettings {
     /// (frozen, the edges polished alone in the steps left); the cap holds them
     /// otherwise.
     pub rows_give_way: u32,
+    /// How the rows' impulses are found.
+    pub solver: ContactSolver,
 }
 
 /// How a joint projection ended.
@@ -69,6 +71,8 @@ pub struct JointOutcome {
     pub residual: f64,
     /// How far (a distance per step) the most violated normal row falls short.
     pub contact_violation: f64,
+    /// Sparse factorizations of the contact Newton.
+    pub factorizations: u32,
 }
 
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
@@ -317,6 +321,13 @@ fn iterate(
     let contact_tolerance = settings.contact_tolerance;
     let mut outcome = JointOutcome::default();
     let mut rows_active = !s.rows.is_empty();
+    if rows_active
+        && settings.solver != ContactSolver::GaussSeidel
+        && super::contact_newton::solve(settings, s, &mut outcome).is_some()
+    {
+        // The rows and edges together; then the edges' polish below, rows frozen.
+        rows_active = false;
+    }
     let mut previous_violation = f64::INFINITY;
     let shortest = s
         .parts
@@ -395,7 +406,7 @@ fn iterate(
 
 /// The edges at the current corrections, their constraint values and each part's
 /// residual; returns the largest.
-fn measure_edges(s: &mut JointScratch) -> f64 {
+pub(super) fn measure_edges(s: &mut JointScratch) -> f64 {
     let mut largest = 0.0f64;
     for part in &mut s.parts {
         let (first, count) = (part.edges.0 as usize, part.edges.1 as usize);
@@ -530,6 +541,19 @@ mod tests {
             dt: f64,
             scratch: &mut JointScratch,
         ) -> JointOutcome {
+            self.project_by(ContactSolver::Newton, velocity, rows, impulses, dt, scratch)
+        }
+
+        /// [`World::project`] with the rows' impulses found by `solver`.
+        fn project_by(
+            &self,
+            solver: ContactSolver,
+            velocity: &mut [DVec2],
+            rows: &[ContactRow],
+            impulses: &mut [RowImpulse],
+            dt: f64,
+            scratch: &mut JointScratch,
+        ) -> JointOutcome {
             let islands: Vec<u32> = (0..self.set.islands.len() as u32).collect();
             let in_island: Vec<u32> = self.set.edges.iter().flat_map(|e| [e.a, e.b]).collect();
             let loose: Vec<u32> = (0..self.position.len() as u32)
@@ -543,7 +567,10 @@ mod tests {
                 rows,
                 impulses,
                 dt,
-                &settings(),
+                &JointSettings {
+                    solver,
+                    ..settings()
+                },
                 scratch,
             )
         }
@@ -593,6 +620,7 @@ mod tests {
             contact_tolerance: TOLERANCE,
             max_correction: f64::INFINITY,
             rows_give_way: 15,
+            solver: ContactSolver::default(),
         }
     }
 
@@ -672,7 +700,14 @@ mod tests {
         ];
         let mut impulses = [RowImpulse::default(); 2];
         let mut scratch = JointScratch::default();
-        let outcome = world.project(&mut velocity, &rows, &mut impulses, dt, &mut scratch);
+        let outcome = world.project_by(
+            ContactSolver::GaussSeidel,
+            &mut velocity,
+            &rows,
+            &mut impulses,
+            dt,
+            &mut scratch,
+        );
         assert!(outcome.converged, "{outcome:?}");
         assert!(impulses[0].normal > 0.0 && impulses[1] == RowImpulse::default());
         // The first row's two links: both strands' 5 particles and 4 edges, normal and
@@ -842,7 +877,7 @@ mod tests {
     }
 
     #[test]
-    fn the_impulses_returned_warm_start_the_same_problem_to_fewer_sweeps() {
+    fn the_impulses_returned_warm_start_the_same_problem_to_the_same_answer() {
         // A strand lying across three pinned posts, pushed down onto them.
         let mut position: Vec<DVec2> = (0..9).map(|i| DVec2::new(0.02 * i as f64, 0.004)).collect();
         position.extend([
@@ -878,21 +913,31 @@ mod tests {
             .iter()
             .map(|&(p, q, r)| row(&world, pair(p, q, r, 0.5), DVec2::Y, 0.004, dt))
             .collect();
-        let mut scratch = JointScratch::default();
-        let mut cold = start.clone();
-        let mut impulses = vec![RowImpulse::default(); 2];
-        let first = world.project(&mut cold, &rows, &mut impulses, dt, &mut scratch);
-        let mut warm = start.clone();
-        let second = world.project(&mut warm, &rows, &mut impulses, dt, &mut scratch);
-        assert!(first.converged && second.converged);
-        assert!(second.sweeps < first.sweeps, "{second:?} against {first:?}");
-        for (a, b) in cold.iter().zip(&warm) {
-            assert!(
-                (*a - *b).length() * dt < 10.0 * TOLERANCE,
-                "{a} against {b}"
-            );
+        for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
+            let mut scratch = JointScratch::default();
+            let mut cold = start.clone();
+            let mut impulses = vec![RowImpulse::default(); 2];
+            let project = |v: &mut [DVec2], i: &mut [RowImpulse], s: &mut JointScratch| {
+                world.project_by(solver, v, &rows, i, dt, s)
+            };
+            let first = project(&mut cold, &mut impulses, &mut scratch);
+            let mut warm = start.clone();
+            let second = project(&mut warm, &mut impulses, &mut scratch);
+            assert!(first.converged && second.converged);
+            // The sweeps start from the answer. Newton's first problem is shifted by
+            // it, but its steps are set by the edges' turning, the same from either
+            // start: it only has to land on the same answer.
+            if solver == ContactSolver::GaussSeidel {
+                assert!(second.sweeps < first.sweeps, "{second:?} against {first:?}");
+            }
+            for (a, b) in cold.iter().zip(&warm) {
+                assert!(
+                    (*a - *b).length() * dt < 10.0 * TOLERANCE,
+                    "{solver:?}: {a} against {b}"
+                );
+            }
+            assert!(world.max_relative_error(&warm, dt) < 1e-12);
         }
-        assert!(world.max_relative_error(&warm, dt) < 1e-12);
     }
 
     #[test]
@@ -928,35 +973,47 @@ mod tests {
                 s => DVec2::new(0.2 * (s % 3) as f64, -0.5 - 0.001 * s as f64),
             })
             .collect();
-        let mut results = Vec::new();
-        for threads in [1, 2] {
-            let mut scratch = JointScratch::default();
-            scratch.set_threads(threads);
-            let mut velocity = start.clone();
-            let mut impulses = vec![RowImpulse::default(); rows.len()];
-            let outcome = world.project(&mut velocity, &rows, &mut impulses, dt, &mut scratch);
-            let (end_0, end_1) = scratch.cut.row_ends;
+        for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
+            let mut results = Vec::new();
+            for threads in [1, 2] {
+                let mut scratch = JointScratch::default();
+                scratch.set_threads(threads);
+                let mut velocity = start.clone();
+                let mut impulses = vec![RowImpulse::default(); rows.len()];
+                let outcome = world.project_by(
+                    solver,
+                    &mut velocity,
+                    &rows,
+                    &mut impulses,
+                    dt,
+                    &mut scratch,
+                );
+                let (end_0, end_1) = scratch.cut.row_ends;
+                assert!(
+                    end_0 > 0 && end_1 > end_0 && end_1 < rows.len(),
+                    "cut: {end_0} {end_1}"
+                );
+                assert!(outcome.converged, "{solver:?}: {outcome:?}");
+                assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+                assert!(
+                    impulses
+                        .iter()
+                        .all(|i| i.normal >= 0.0 && i.tangent.is_finite())
+                );
+                assert!(impulses.iter().filter(|i| i.normal > 0.0).count() > rows.len() / 2);
+                let velocity_bits = |v: &[DVec2]| -> Vec<[u64; 2]> {
+                    v.iter().map(|v| v.to_array().map(f64::to_bits)).collect()
+                };
+                let impulse_bits: Vec<[u64; 2]> = (impulses.iter())
+                    .map(|i| [i.normal.to_bits(), i.tangent.to_bits()])
+                    .collect();
+                results.push((velocity_bits(&velocity), impulse_bits, outcome.sweeps));
+            }
             assert!(
-                end_0 > 0 && end_1 > end_0 && end_1 < rows.len(),
-                "cut: {end_0} {end_1}"
+                results[0] == results[1],
+                "{solver:?}: one thread and two differ"
             );
-            assert!(outcome.converged, "{outcome:?}");
-            assert!(world.max_relative_error(&velocity, dt) < 1e-12);
-            assert!(
-                impulses
-                    .iter()
-                    .all(|i| i.normal >= 0.0 && i.tangent.is_finite())
-            );
-            assert!(impulses.iter().filter(|i| i.normal > 0.0).count() > rows.len() / 2);
-            let velocity_bits = |v: &[DVec2]| -> Vec<[u64; 2]> {
-                v.iter().map(|v| v.to_array().map(f64::to_bits)).collect()
-            };
-            let impulse_bits: Vec<[u64; 2]> = (impulses.iter())
-                .map(|i| [i.normal.to_bits(), i.tangent.to_bits()])
-                .collect();
-            results.push((velocity_bits(&velocity), impulse_bits, outcome.sweeps));
         }
-        assert!(results[0] == results[1], "one thread and two differ");
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use bevy::math::DVec2;
 
+use super::contact_newton::NewtonScratch;
 use super::joint_split::JointCut;
 use super::scratch::{Factors, IslandScratch};
 
@@ -111,6 +112,8 @@ pub struct JointScratch {
     pub(super) part_factors: Vec<Factors>,
     /// Whether each part met its edges (by part), after the last call.
     pub(super) met: Vec<bool>,
+    /// The contact Newton's buffers.
+    pub(super) newton: NewtonScratch,
 }
 
 /// Room for the responses of one group of rows, taken as they first push.

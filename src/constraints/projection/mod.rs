@@ -31,6 +31,8 @@
 //! loop is in `newton`, the assembly and solve of the system in `assembly`.
 
 mod assembly;
+mod contact_kkt;
+mod contact_newton;
 mod contact_rows;
 mod joint;
 mod joint_rows;
@@ -47,7 +49,9 @@ pub use joint::{JointOutcome, JointSettings, project_jointly};
 pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
 pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
-pub use settings::{ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR};
+pub use settings::{
+    ConstraintDirection, ContactSolver, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
+};
 pub use view::{Bodies, Chain, Graph, IslandView};
 
 use newton::project_walk;

@@ -13,6 +13,61 @@ pub enum ConstraintDirection {
     StartOfStep,
 }
 
+/// How a joint projection finds its contact rows' impulses.
+#[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum ContactSolver {
+    /// Each joint projection by whichever of the two below costs less for it (an
+    /// estimate from the rows' response lengths and the factor's fill): Newton for
+    /// long strands, the sweeps for short ones in a dense pile.
+    #[default]
+    Auto,
+    /// Newton's method on the rows and edges together, one sparse factorization a
+    /// Newton step: a row costs its own particles whatever the strands' lengths.
+    Newton,
+    /// Projected Gauss–Seidel over each row's response on the whole strands it
+    /// touches, inside the edges' Newton steps (the earlier design, kept as a
+    /// baseline).
+    GaussSeidel,
+}
+
+impl ContactSolver {
+    /// Every solver, in the order they are listed.
+    pub const ALL: [ContactSolver; 3] = [
+        ContactSolver::Auto,
+        ContactSolver::Newton,
+        ContactSolver::GaussSeidel,
+    ];
+
+    /// The solver's name on the command line: `auto`, `newton`, `gauss-seidel`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactSolver::Auto => "auto",
+            ContactSolver::Newton => "newton",
+            ContactSolver::GaussSeidel => "gauss-seidel",
+        }
+    }
+}
+
+impl std::fmt::Display for ContactSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ContactSolver {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                format!("unknown contact solver '{s}'; valid solvers: auto, newton, gauss-seidel")
+            })
+    }
+}
+
 /// Stopping rule of the projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProjectionSettings {

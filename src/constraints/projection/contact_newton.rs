@@ -1,0 +1,773 @@
+//! The contact Newton: a joint projection's rows and edges solved together by Newton's
+//! method on one sparse system, so that a row costs its own three particles whatever
+//! the length of the strands it touches.
+//!
+//! Each row is two rows of Coulomb's cone, the cone's edges `e± = (1, ±μ) / √(1 + μ²)`
+//! in the row's (normal, tangent) plane: a contact pushes along `n ± μ t` with impulses
+//! `λ± ≥ 0`, so its impulse is inside the cone by construction, and it holds `u± =
+//! e±·(u_n, u_t) ≥ 0`, `u_n` how far the pair ends clear of its target and `u_t` how far
+//! it slides (a sticking contact meets both edges, `u_n = u_t = 0`; a sliding one the
+//! edge behind its sliding, ending `μ |u_t|` clear: Anitescu's convex cone). The
+//! corrections Δ minimize, over the motions the edges allow,
+//!
+//! `½ Δᵀ M Δ + Σ_rows Σ± ½ k min(0, u± − λ̄± / k)²`,
+//!
+//! `k` a stiffness a thousand times the row's own mass and `λ̄±` the impulses of the
+//! last solve (an augmented Lagrangian: a pressed row converges onto its target, not
+//! `λ/k` short of it). The objective is convex, piecewise quadratic and strictly convex
+//! whatever the rows: rows that are exact combinations of others (a tenth of a mat of
+//! hair's, where Gauss–Seidel stalls and a textbook active set cycles) leave the motion
+//! unique.
+//!
+//! Each Newton step linearizes the edges at the iterate and solves `[H Jᵀ; J 0]`
+//! (`contact_kkt`) twice with one factorization: for the full step, and for the step
+//! that only meets the edges. The edges' part is taken whole; the rest is taken whole
+//! for a few steps (the rows' states then follow the iterate, as in a primal–dual
+//! active set), then with an exact line search on the objective (MuJoCo's primal
+//! Newton, Todorov 2014, with hard edges). The iterate is kept as impulses, every row's
+//! and edge's equal and opposite on its particles, and Δ = W P: momentum is kept to
+//! round-off at every step. Once the rows are met and the edges nearly so, the joint
+//! projection's last Newton steps polish the edges alone (`joint`).
+
+use bevy::math::DVec2;
+
+use super::contact_kkt::{Kkt, KktInput, NONE, RowModel};
+use super::joint::{JointOutcome, JointSettings, measure_edges};
+use super::joint_state::{JointRow, JointScratch};
+use super::settings::{ContactSolver, ROUND_OFF_FLOOR};
+
+/// A row's contact stiffness over its own mass `1 / Σ cᵢ² wᵢ`: soft enough that a step
+/// pressing a new row is not stopped at it, stiff enough that a row pressed by impulse
+/// λ gives `λ / k`, a thousandth of the motion it stops, before its shift takes it up.
+const STIFFNESS: f64 = 1e3;
+
+/// Newton steps taken whole (up to the trust region) after each new shift, before the
+/// line search guards them.
+const FULL_STEPS: u32 = 6;
+
+/// Newton steps without the rows' shortfall halving after which they are left as they
+/// are.
+const STALL: u32 = 4;
+
+/// The buffers of the contact Newton, reused.
+#[derive(Clone, Debug, Default)]
+pub(super) struct NewtonScratch {
+    pub(super) kkt: Kkt,
+    model: Vec<RowModel>,
+    /// Which rows the system's pattern holds.
+    included: Vec<bool>,
+    /// Which of each row's cone edges the model presses.
+    pressed: Vec<[bool; 2]>,
+    /// Each row's stiffness (zero: the row is inert).
+    stiffness: Vec<f64>,
+    /// Impulses (mass × length) on each joint particle: Δ = W P.
+    momentum: Vec<DVec2>,
+    start: Vec<DVec2>,
+    step: Vec<DVec2>,
+    /// Each row's cone impulses λ± at the iterate, at the line's start and along it.
+    lambda: Vec<[f64; 2]>,
+    start_lambda: Vec<[f64; 2]>,
+    step_lambda: Vec<[f64; 2]>,
+    /// Whether this Newton step is taken whole (see [`edge_force`]).
+    whole: bool,
+    /// Each row's shifts λ̄± / k, and its lift.
+    shift: Vec<[f64; 2]>,
+    lift: Vec<f64>,
+    /// Each joint edge's impulse (tension positive) at the iterate, the line's start
+    /// and along it.
+    tension: Vec<f64>,
+    start_tension: Vec<f64>,
+    step_tension: Vec<f64>,
+    /// Each joint edge's curvature in this step's system.
+    curvature: Vec<f64>,
+    /// Each row's shifted cone values at the line's start, their change along it, and
+    /// their values at the end of the last step when the line search stopped short.
+    value: Vec<[f64; 2]>,
+    slope: Vec<[f64; 2]>,
+    ahead: Vec<[f64; 2]>,
+    full: Vec<f64>,
+    feasible: Vec<f64>,
+}
+
+/// The edges of a row's cone in its (normal, tangent) plane; without friction one
+/// edge, the normal (the second is then unused).
+fn cone(friction: f64) -> [(f64, f64); 2] {
+    let s = (1.0 + friction * friction).sqrt();
+    [(1.0 / s, friction / s), (1.0 / s, -friction / s)]
+}
+
+/// How many of a row's cone edges act.
+fn edges(friction: f64) -> usize {
+    if friction > 0.0 { 2 } else { 1 }
+}
+
+/// `Σ cᵢ d·vᵢ` along the row's normal and tangent.
+fn row_motion(row: &JointRow, v: &[DVec2]) -> (f64, f64) {
+    let (n, t) = (row.normal, row.normal.perp());
+    let (mut a, mut b) = (0.0, 0.0);
+    for &(j, c) in &row.entries[..row.count as usize] {
+        a += c * n.dot(v[j as usize]);
+        b += c * t.dot(v[j as usize]);
+    }
+    (a, b)
+}
+
+/// A row's normal and tangent values `slack + Σ cᵢ d·Δᵢ` for corrections `delta`.
+fn row_values(row: &JointRow, delta: &[DVec2]) -> (f64, f64) {
+    let (a, b) = row_motion(row, delta);
+    (row.slack_n + a, row.slack_t + b)
+}
+
+/// A row's motion along its normal and tangent for the particle unknowns in `x`.
+fn unknown_motion(row: &JointRow, particle_unknown: &[u32], x: &[f64]) -> (f64, f64) {
+    let (n, t) = (row.normal, row.normal.perp());
+    let (mut a, mut b) = (0.0, 0.0);
+    for &(j, c) in &row.entries[..row.count as usize] {
+        let u = particle_unknown[j as usize];
+        if u != NONE {
+            let d = DVec2::new(x[u as usize], x[u as usize + 1]);
+            a += c * n.dot(d);
+            b += c * t.dot(d);
+        }
+    }
+    (a, b)
+}
+
+/// Row `r`'s cone values at corrections `delta`, shifted by its impulses and with its
+/// normal value lifted by what its sliding asked of it last time (see [`run`]).
+fn cone_values(row: &JointRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> [f64; 2] {
+    let (un, ut) = row_values(row, delta);
+    let un = un + w.lift[r];
+    let e = cone(row.friction);
+    [0, 1].map(|x| e[x].0 * un + e[x].1 * ut - w.shift[r][x])
+}
+
+/// The (normal, tangent) impulse of cone impulses `lambda`.
+fn impulse(friction: f64, lambda: [f64; 2]) -> (f64, f64) {
+    let e = cone(friction);
+    let mut out = (0.0, 0.0);
+    for (edge, l) in e.iter().zip(lambda).take(edges(friction)) {
+        out.0 += l * edge.0;
+        out.1 += l * edge.1;
+    }
+    out
+}
+
+/// Add `row`'s impulse `(normal, tangent)` to the particles' impulses `p`.
+fn push(row: &JointRow, impulse: (f64, f64), p: &mut [DVec2]) {
+    let direction = impulse.0 * row.normal + impulse.1 * row.normal.perp();
+    for &(j, c) in &row.entries[..row.count as usize] {
+        p[j as usize] += c * direction;
+    }
+}
+
+/// Add `tension` of the edge from `a` to `b` along `d` to `p`: it pulls the ends
+/// together.
+fn pull(a: u32, b: u32, d: DVec2, tension: f64, p: &mut [DVec2]) {
+    p[a as usize] += tension * d;
+    p[b as usize] -= tension * d;
+}
+
+/// The line of one Newton step: the objective's derivative and slope along it.
+struct Line<'a> {
+    rows: &'a [JointRow],
+    stiffness: &'a [f64],
+    value: &'a [[f64; 2]],
+    slope: &'a [[f64; 2]],
+    /// `Σ Pa·W Pb` and `Σ Pb·W Pb` of the masses' term.
+    mass: (f64, f64),
+}
+
+impl Line<'_> {
+    /// `f'(α)` and `f''(α⁺)`.
+    fn derivative(&self, alpha: f64) -> (f64, f64) {
+        let (mut d, mut dd) = (self.mass.0 + alpha * self.mass.1, self.mass.1);
+        for (r, row) in self.rows.iter().enumerate() {
+            let k = self.stiffness[r];
+            if k == 0.0 {
+                continue;
+            }
+            for e in 0..edges(row.friction) {
+                let v = self.slope[r][e];
+                let u = self.value[r][e] + alpha * v;
+                if u < 0.0 || (u == 0.0 && v < 0.0) {
+                    d += k * u * v;
+                    dd += k * v * v;
+                }
+            }
+        }
+        (d, dd)
+    }
+
+    /// The minimizer of the convex piecewise-quadratic objective on `[0, high]`.
+    fn minimize(&self, high: f64) -> f64 {
+        let (g0, mut s_lo) = self.derivative(0.0);
+        if g0 >= 0.0 {
+            return 0.0;
+        }
+        // Within round-off of a flat derivative, the far end is the answer.
+        let (mut g_hi, _) = self.derivative(high);
+        if g_hi <= 1e-9 * g0.abs() {
+            return high;
+        }
+        let (mut lo, mut hi, mut g_lo) = (0.0, high, g0);
+        for _ in 0..60 {
+            let mut alpha = if s_lo > 0.0 { lo - g_lo / s_lo } else { hi };
+            if !(alpha > lo && alpha < hi) {
+                alpha = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+            }
+            if !(alpha > lo && alpha < hi) {
+                break;
+            }
+            let (g, s) = self.derivative(alpha);
+            if g.abs() <= 1e-14 * g0.abs() {
+                return alpha;
+            }
+            if g < 0.0 {
+                (lo, g_lo, s_lo) = (alpha, g, s);
+            } else {
+                (hi, g_hi) = (alpha, g);
+            }
+            if hi - lo <= 1e-15 * high {
+                break;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+/// Solve the rows and edges of the laid-out joint projection in `s` together, from
+/// the rows' warm-start impulses: `s.correction`, the rows' impulses and the edges'
+/// impulses hold the result. Returns whether the rows were met, or `None`, touching
+/// nothing, when the sweeps would cost less (see [`prefers_sweeps`]).
+pub(super) fn solve(
+    settings: &JointSettings,
+    s: &mut JointScratch,
+    outcome: &mut JointOutcome,
+) -> Option<bool> {
+    let mut newton = std::mem::take(&mut s.newton);
+    let met = run(settings, s, &mut newton, outcome);
+    s.newton = newton;
+    met
+}
+
+/// What a Gauss–Seidel row update costs per particle of the strands it touches, over
+/// what the factorization costs per unit of its work (Σ of its columns' counts
+/// squared), each times how often it is done in a projection: about forty sweeps at
+/// 1.5 ns a particle, about four factorizations at 0.7 ns a unit (a dropped pile and
+/// a coiling rope, one thread, measured).
+const SWEEPS_OVER_FACTORIZATIONS: f64 = 20.0;
+
+/// Whether the sweeps over the rows' responses would cost less than the Newton steps'
+/// factorizations: short strands in a dense pile, where each response is a few
+/// particles long and the system's fill is not. Long strands are the other way: a
+/// response is as long as its strand, a factor's column is not.
+fn prefers_sweeps(s: &JointScratch, work: f64) -> bool {
+    work > SWEEPS_OVER_FACTORIZATIONS * responses(s)
+}
+
+/// The particles of every row's responses: what a sweep over the rows writes.
+fn responses(s: &JointScratch) -> f64 {
+    s.rows
+        .iter()
+        .flat_map(|row| &row.links[..row.link_count as usize])
+        .map(|&(part, ..)| f64::from(s.parts[part as usize].particles.1))
+        .sum()
+}
+
+/// Responses shorter than this many particles on average are left to the sweeps
+/// without weighing the factorization (whose analysis alone costs a few of their
+/// sweeps): a pile's or a fur's strands, where the sweeps measured two to six times
+/// faster.
+const SHORT_RESPONSES: f64 = 48.0;
+
+fn kkt_input<'a>(s: &'a JointScratch, included: &'a [bool]) -> KktInput<'a> {
+    KktInput {
+        inverse_mass: &s.inverse_mass,
+        included,
+        ends: &s.ends,
+        locked: &s.locked,
+        incident: &s.incident,
+        incident_start: &s.incident_start,
+        rows: &s.rows,
+    }
+}
+
+/// Whether any of a row's cone edges is short at the corrections.
+fn short(row: &JointRow, delta: &[DVec2]) -> bool {
+    let (un, ut) = row_values(row, delta);
+    let e = cone(row.friction);
+    (0..edges(row.friction)).any(|x| e[x].0 * un + e[x].1 * ut < 0.0)
+}
+
+fn run(
+    settings: &JointSettings,
+    s: &mut JointScratch,
+    w: &mut NewtonScratch,
+    outcome: &mut JointOutcome,
+) -> Option<bool> {
+    let n = s.packed.len();
+    let rows = s.rows.len();
+    w.kkt.factorizations = 0;
+    let links: usize = s.rows.iter().map(|row| row.link_count as usize).sum();
+    if settings.solver == ContactSolver::Auto && responses(s) < SHORT_RESPONSES * links as f64 {
+        return None;
+    }
+    w.stiffness.clear();
+    w.shift.clear();
+    for row in &s.rows {
+        let own: f64 = row.entries[..row.count as usize]
+            .iter()
+            .map(|&(j, c)| c * c * s.inverse_mass[j as usize])
+            .sum();
+        let k = if own > 0.0 { STIFFNESS / own } else { 0.0 };
+        w.stiffness.push(k);
+        // The warm start is the shift: the first problem already asks each row for last
+        // step's impulses where it is met. Applying them as impulses instead would move
+        // their particles alone, as far as they stop whole strands.
+        let lambda = warm_lambda(row);
+        w.shift.push(if k > 0.0 {
+            [lambda[0] / k, lambda[1] / k]
+        } else {
+            [0.0; 2]
+        });
+    }
+    w.model.clear();
+    w.model.resize(rows, RowModel::default());
+    w.lift.clear();
+    w.lift.resize(rows, 0.0);
+    w.pressed.clear();
+    w.pressed.resize(rows, [false; 2]);
+    w.lambda.clear();
+    w.lambda.resize(rows, [0.0; 2]);
+    w.momentum.clear();
+    w.momentum.resize(n, DVec2::ZERO);
+    w.tension.clear();
+    w.tension.resize(s.ends.len(), 0.0);
+    w.ahead.clear();
+    // The system's pattern holds the rows that can press at first (warm, or short of
+    // their cone at the prediction), and grows when a step presses another: rows
+    // within reach but clear would couple their particles for nothing (forty times
+    // the work on a dropped pile).
+    set_correction(s, &w.momentum);
+    w.included.clear();
+    for (r, row) in s.rows.iter().enumerate() {
+        let warm = w.shift[r].iter().any(|&x| x > 0.0);
+        w.included
+            .push(w.stiffness[r] > 0.0 && (warm || short(row, &s.correction)));
+    }
+    w.kkt.number(&kkt_input(s, &w.included));
+    if settings.solver == ContactSolver::Auto && prefers_sweeps(s, w.kkt.work()) {
+        return None;
+    }
+    let tolerance = settings.contact_tolerance;
+    let cap = settings.rows_give_way.max(1);
+    let trust = 0.5
+        * s.parts
+            .iter()
+            .map(|p| p.shortest)
+            .fold(f64::INFINITY, f64::min);
+    // Once the rows are met, the edges' polish moves particles by about the residual
+    // times an edge: no more than the contact tolerance.
+    let polish = (tolerance / (2.0 * trust)).clamp(ROUND_OFF_FLOOR, 1e-3);
+    let mut last_violation = f64::INFINITY;
+    let mut full_until = FULL_STEPS;
+    let mut met = false;
+    let mut best = (f64::INFINITY, 0);
+    let mut renewed = false;
+    for step in 0..cap {
+        set_correction(s, &w.momentum);
+        measure_edges(s);
+        choose_model(s, w, step == 0, renewed);
+        renewed = false;
+        let mut grew = false;
+        for (included, model) in w.included.iter_mut().zip(&w.model) {
+            if !*included && !model.is_empty() {
+                *included = true;
+                grew = true;
+            }
+        }
+        if grew {
+            w.kkt.number(&kkt_input(s, &w.included));
+        }
+        let unknowns = w.kkt.unknowns();
+        // Taut edges' curvature (tension over length) makes the steps Newton's on the
+        // manifold the edges allow, not on its tangent plane; slack ones are left out,
+        // so the system stays quasi-definite.
+        w.curvature.clear();
+        (w.curvature).extend(
+            w.tension
+                .iter()
+                .zip(&s.edge)
+                .map(|(&t, d)| t.max(0.0) / d.length()),
+        );
+        if (w.kkt)
+            .assemble_and_factor(&kkt_input(s, &w.included), &w.model, &s.edge, &w.curvature)
+            .is_err()
+        {
+            break;
+        }
+        outcome.iterations += 1;
+        w.whole = step < full_until;
+        right_hand_sides(s, w, unknowns);
+        w.kkt.solve(&mut w.full);
+        w.kkt.solve(&mut w.feasible);
+        lines(s, w);
+        // The line: its start (the edges met) and the way to the full step's end.
+        set_correction(s, &w.start);
+        let mut mass = (0.0, 0.0);
+        let mut longest = 0.0f64;
+        for j in 0..n {
+            let b = s.inverse_mass[j] * w.step[j];
+            mass.0 += w.start[j].dot(b);
+            mass.1 += w.step[j].dot(b);
+            longest = longest.max(b.length());
+        }
+        shifted_values(s, w);
+        set_correction(s, &w.step);
+        w.slope.clear();
+        for row in &s.rows {
+            let (a, b) = row_motion(row, &s.correction);
+            let e = cone(row.friction);
+            w.slope.push(e.map(|e| e.0 * a + e.1 * b));
+        }
+        let high = if longest > trust {
+            trust / longest
+        } else {
+            1.0
+        };
+        let line = Line {
+            rows: &s.rows,
+            stiffness: &w.stiffness,
+            value: &w.value,
+            slope: &w.slope,
+            mass,
+        };
+        // Whole steps first, so that the rows' states follow the iterate several at
+        // once; then a line search, which may stop at the first stiff row a step
+        // presses but never goes uphill.
+        let alpha = if w.whole { high } else { line.minimize(high) };
+        w.ahead.clear();
+        if alpha < 1.0 {
+            let ahead = w.value.iter().zip(&w.slope);
+            w.ahead
+                .extend(ahead.map(|(v, d)| [v[0] + d[0], v[1] + d[1]]));
+        }
+        for j in 0..n {
+            w.momentum[j] = w.start[j] + alpha * w.step[j];
+        }
+        for r in 0..rows {
+            for e in 0..2 {
+                w.lambda[r][e] = w.start_lambda[r][e] + alpha * w.step_lambda[r][e];
+            }
+        }
+        for k in 0..s.ends.len() {
+            w.tension[k] = w.start_tension[k] + alpha * w.step_tension[k];
+        }
+        set_correction(s, &w.momentum);
+        // A step whose part left untaken moves nothing that matters is taken whole.
+        let whole = (1.0 - alpha) * longest <= 1e-3 * tolerance;
+        let violation = violation(s, w);
+        let holds = whole && model_holds(s, w, tolerance);
+        // Until the edges are nearly met, their next linearization moves the rows
+        // more than a shift would: solve again before judging the rows.
+        let settled = measure_edges(s) <= polish;
+        met = holds && violation <= tolerance;
+        if met && settled {
+            break;
+        }
+        if !(holds && settled) {
+            // Rows that stop improving (a degenerate cluster trading impulses between
+            // cone edges that are combinations of each other) are left where they are
+            // once the edges are within what they fall short, as the sweeps' rows
+            // were: the polish then moves particles by no more than that.
+            if violation < 0.5 * best.0 {
+                best = (violation, step);
+            } else if step >= best.1 + STALL
+                && measure_edges(s) <= (violation.max(tolerance) / (2.0 * trust)).min(1e-3)
+            {
+                break;
+            }
+            continue;
+        }
+        if met {
+            continue;
+        }
+        // The rows' give is over the tolerance (a heavy load on a light row): shift
+        // each row by its impulse and solve again. Rows that cannot all be met stall.
+        if violation > 0.5 * last_violation {
+            break;
+        }
+        last_violation = violation;
+        // A sliding row is lifted by what the cone asked of it, μ |u_t| (Tasora and
+        // Anitescu's fixed point): solved again, it slides on its target, not above.
+        for (r, row) in s.rows.iter().enumerate() {
+            let [a, b] = w.pressed[r];
+            w.lift[r] = if a != b {
+                row.friction * row_values(row, &s.correction).1.abs()
+            } else {
+                0.0
+            };
+        }
+        for (r, shift) in w.shift.iter_mut().enumerate() {
+            let k = w.stiffness[r];
+            if k > 0.0 {
+                *shift = w.lambda[r].map(|l| l.max(0.0) / k);
+            }
+        }
+        full_until = step + 1 + FULL_STEPS;
+        renewed = true;
+    }
+    // Each row's impulses; a cone edge the last step left pulling keeps it (it is in
+    // Δ), but carries none into the next step's warm start.
+    for (row, lambda) in s.rows.iter_mut().zip(&w.lambda) {
+        (row.mu_n, row.mu_t) = impulse(row.friction, lambda.map(|l| l.max(0.0)));
+    }
+    for (impulse, tension) in s.edge_impulse.iter_mut().zip(&w.tension) {
+        *impulse += tension;
+    }
+    outcome.factorizations += w.kkt.factorizations;
+    Some(met)
+}
+
+/// A row's warm cone impulses from its (normal, tangent) warm start, inside the cone.
+fn warm_lambda(row: &JointRow) -> [f64; 2] {
+    let normal = row.mu_n.max(0.0);
+    if row.friction <= 0.0 {
+        return [normal, 0.0];
+    }
+    let s = (1.0 + row.friction * row.friction).sqrt();
+    let along = (row.mu_t / row.friction).clamp(-normal, normal);
+    [0.5 * s * (normal + along), 0.5 * s * (normal - along)]
+}
+
+/// The model at the iterate: which cone edges of each row press. An edge presses if it
+/// is short at the iterate, or at the end of the last step where the line search
+/// stopped before it (the step would have pressed it), or if the model pressed it and
+/// it still pushes without being clear (the model leaves it at −λ/k, zero where λ is);
+/// on the first step, every edge with a warm impulse.
+fn choose_model(s: &JointScratch, w: &mut NewtonScratch, first: bool, renewed: bool) {
+    w.value.clear();
+    for (r, row) in s.rows.iter().enumerate() {
+        let k = w.stiffness[r];
+        let values = cone_values(row, r, w, &s.correction);
+        let e = cone(row.friction);
+        let mut model = RowModel::default();
+        let mut value = [0.0; 2];
+        let mut pressed = [false; 2];
+        for x in 0..edges(row.friction) {
+            let u = values[x];
+            value[x] = u;
+            if k == 0.0 {
+                continue;
+            }
+            let ahead = w.ahead.get(r).is_some_and(|a| a[x] < 0.0);
+            // A primal–dual active set's rule: an edge stays pressed while its impulse
+            // outweighs how far it is clear, λ − k u > 0, so an edge the edges'
+            // curvature lifts a little off its target keeps what holds it.
+            let held = if first {
+                k * w.shift[r][x]
+            } else {
+                w.lambda[r][x]
+            };
+            // Just after the shifts and lifts are renewed, every pushing edge stays: a
+            // lift moves its target by more than its give, λ/k, and a pressed edge
+            // would otherwise seem clear and be dropped for a step.
+            let kept = held > 0.0 && (renewed || held - k * u > 0.0);
+            if u < 0.0 || ahead || kept {
+                pressed[x] = true;
+                model.nn += k * e[x].0 * e[x].0;
+                model.nt += k * e[x].0 * e[x].1;
+                model.tt += k * e[x].1 * e[x].1;
+            }
+        }
+        w.model[r] = model;
+        w.pressed[r] = pressed;
+        w.value.push(value);
+    }
+}
+
+/// The rows' shifted cone values at the current corrections, into `w.value`.
+fn shifted_values(s: &JointScratch, w: &mut NewtonScratch) {
+    w.value.clear();
+    for (r, row) in s.rows.iter().enumerate() {
+        let values = cone_values(row, r, w, &s.correction);
+        w.value.push(values);
+    }
+}
+
+/// The right-hand sides: the full step (the objective's forces at the iterate) and
+/// the step that only meets the edges.
+fn right_hand_sides(s: &JointScratch, w: &mut NewtonScratch, unknowns: usize) {
+    w.full.clear();
+    w.full.resize(unknowns, 0.0);
+    w.feasible.clear();
+    w.feasible.resize(unknowns, 0.0);
+    for (j, p) in w.momentum.iter().enumerate() {
+        let u = w.kkt.particle_unknown[j];
+        if u != NONE {
+            w.full[u as usize] = -p.x;
+            w.full[u as usize + 1] = -p.y;
+        }
+    }
+    for (r, row) in s.rows.iter().enumerate() {
+        let force = impulse(row.friction, [0, 1].map(|x| edge_force(w, r, x)));
+        if force == (0.0, 0.0) {
+            continue;
+        }
+        let direction = force.0 * row.normal + force.1 * row.normal.perp();
+        for &(j, c) in &row.entries[..row.count as usize] {
+            let u = w.kkt.particle_unknown[j as usize];
+            if u != NONE {
+                w.full[u as usize] += c * direction.x;
+                w.full[u as usize + 1] += c * direction.y;
+            }
+        }
+    }
+    for (k, &e) in w.kkt.edge_unknown.iter().enumerate() {
+        if e != NONE {
+            let rhs = -s.constraint[k] / (2.0 * s.edge[k].length());
+            w.full[e as usize] = rhs;
+            w.feasible[e as usize] = rhs;
+        }
+    }
+}
+
+/// Cone edge `x` of row `r`'s impulse in this step's model at its shifted value. In
+/// whole steps, a primal–dual active set's: the model's linear force on a pressed
+/// edge, pulling if the edge is clear (its target is where the model holds it). With
+/// the line search, minus the objective's gradient, whatever the model presses (the
+/// model then only chooses the Hessian, so every step goes downhill).
+fn edge_force(w: &NewtonScratch, r: usize, x: usize) -> f64 {
+    let (k, u) = (w.stiffness[r], w.value[r][x]);
+    if w.whole && w.pressed[r][x] {
+        -k * u
+    } else {
+        k * (-u).max(0.0)
+    }
+}
+
+/// The line of this Newton step: its start (the step that meets the edges taken, the
+/// rows' impulses as the model moves them there) in `w.start`, and the way from there
+/// to the full step's end in `w.step`, as particle impulses, cone impulses and edge
+/// tensions, each a sum of equal and opposite impulses.
+fn lines(s: &JointScratch, w: &mut NewtonScratch) {
+    let n = s.packed.len();
+    w.start.clear();
+    w.start.extend_from_slice(&w.momentum);
+    w.step.clear();
+    w.step.resize(n, DVec2::ZERO);
+    w.start_lambda.clear();
+    w.step_lambda.clear();
+    for (r, row) in s.rows.iter().enumerate() {
+        let k = w.stiffness[r];
+        let e = cone(row.friction);
+        let (dn_f, dt_f) = unknown_motion(row, &w.kkt.particle_unknown, &w.feasible);
+        let (dn, dt) = unknown_motion(row, &w.kkt.particle_unknown, &w.full);
+        let (mut start, mut end) = ([0.0; 2], [0.0; 2]);
+        for x in 0..edges(row.friction) {
+            let force = edge_force(w, r, x);
+            let held = if k > 0.0 && w.pressed[r][x] { k } else { 0.0 };
+            start[x] = w.lambda[r][x] - held * (e[x].0 * dn_f + e[x].1 * dt_f);
+            end[x] = force - held * (e[x].0 * dn + e[x].1 * dt);
+        }
+        let (now, first) = (
+            impulse(row.friction, w.lambda[r]),
+            impulse(row.friction, start),
+        );
+        push(row, (first.0 - now.0, first.1 - now.1), &mut w.start);
+        push(row, impulse(row.friction, end), &mut w.step);
+        w.start_lambda.push(start);
+        w.step_lambda.push([end[0] - start[0], end[1] - start[1]]);
+    }
+    w.start_tension.clear();
+    w.step_tension.clear();
+    for (k, &(a, b)) in s.ends.iter().enumerate() {
+        let e = w.kkt.edge_unknown[k];
+        let (feasible, full) = if e == NONE {
+            (0.0, 0.0)
+        } else {
+            (w.feasible[e as usize], w.full[e as usize])
+        };
+        // The edges' multipliers λ enter as −Jᵀλ: a tension λ pulling a to b; their
+        // curvature as −G δ, equal and opposite on the ends.
+        let d = s.edge[k].normalize_or_zero();
+        pull(a, b, d, feasible, &mut w.start);
+        pull(a, b, d, full, &mut w.step);
+        let c = w.curvature[k];
+        if c > 0.0 {
+            let motion = |x: &[f64]| -> DVec2 {
+                let at = |j: u32| {
+                    let u = w.kkt.particle_unknown[j as usize];
+                    if u == NONE {
+                        DVec2::ZERO
+                    } else {
+                        DVec2::new(x[u as usize], x[u as usize + 1])
+                    }
+                };
+                at(b) - at(a)
+            };
+            pull(a, b, c * motion(&w.feasible), 1.0, &mut w.start);
+            pull(a, b, c * motion(&w.full), 1.0, &mut w.step);
+        }
+        let start = w.tension[k] + feasible;
+        w.start_tension.push(start);
+        w.step_tension.push(full - start);
+    }
+    // `step` held the full step's end: make it the way there.
+    for (step, start) in w.step.iter_mut().zip(&w.start) {
+        *step -= *start;
+    }
+}
+
+/// Whether the rows at the iterate are as the model held them: pressed cone edges
+/// still pushing, the others clear (within a thousandth of the tolerance, so that an
+/// edge at the border of both may be taken for either).
+fn model_holds(s: &JointScratch, w: &NewtonScratch, tolerance: f64) -> bool {
+    let slack = 1e-3 * tolerance;
+    s.rows.iter().enumerate().all(|(r, row)| {
+        let k = w.stiffness[r];
+        if k == 0.0 {
+            return true;
+        }
+        let values = cone_values(row, r, w, &s.correction);
+        // An impulse's slack is what moves the row's own mass by the slack.
+        let own = k / STIFFNESS;
+        (0..edges(row.friction)).all(|x| {
+            if w.pressed[r][x] {
+                w.lambda[r][x] >= -own * slack
+            } else {
+                values[x] >= -slack
+            }
+        })
+    })
+}
+
+/// How far (a distance per step) the rows are from Coulomb's law at the iterate: a row
+/// short of its target, a pressed one clear of it (the convex cone lifts a sliding
+/// contact by μ times its sliding), a sticking one sliding.
+fn violation(s: &JointScratch, w: &NewtonScratch) -> f64 {
+    let mut worst = 0.0f64;
+    for (r, row) in s.rows.iter().enumerate() {
+        if w.stiffness[r] == 0.0 {
+            continue;
+        }
+        let (un, ut) = row_values(row, &s.correction);
+        let [a, b] = w.pressed[r];
+        worst = worst.max(-un);
+        if a || b {
+            worst = worst.max(un);
+        }
+        if a && b {
+            worst = worst.max(ut.abs());
+        }
+    }
+    worst
+}
+
+/// `s.correction = W p` (fixed particles stay).
+fn set_correction(s: &mut JointScratch, p: &[DVec2]) {
+    for ((c, &w), p) in s.correction.iter_mut().zip(&s.inverse_mass).zip(p) {
+        *c = w * *p;
+    }
+}
