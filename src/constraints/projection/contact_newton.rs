@@ -473,7 +473,6 @@ fn run(
         let whole = (1.0 - alpha) * longest <= 1e-3 * tolerance;
         let violation = violation(s, w);
         let holds = whole && model_holds(s, w, tolerance);
-        if std::env::var("NT").is_ok() { eprintln!("newton {step}: alpha {alpha:.3e} whole {whole} holds {holds} violation {violation:.3e} residual {:.3e} pressed {} included {} unknowns {} work {:.2e} longest {longest:.2e}", measure_edges(s), w.pressed.iter().filter(|p| p[0]||p[1]).count(), w.included.iter().filter(|p| **p).count(), w.kkt.unknowns(), w.kkt.work()); }
         // Until the edges are nearly met, their next linearization moves the rows
         // more than a shift would: solve again before judging the rows.
         let settled = measure_edges(s) <= polish;
