@@ -1,21 +1,24 @@
-//! Sparse LDLᵀ of a symmetric quasi-definite matrix, numbered in elimination order: the
-//! linear solve of the contact Newton's systems (`projection::contact_newton`).
+//! The pattern of a symmetric quasi-definite matrix numbered in elimination order, its
+//! elimination tree and factor column counts: the analysis the supernodal factorization
+//! (`supernodal`) plans from. The column-by-column factorization here is its reference
+//! in tests.
 //!
-//! Those systems couple particles (positive definite blocks: masses, contact
+//! The contact Newton's systems couple particles (positive definite blocks: masses, contact
 //! stiffness) with edge multipliers (a zero diagonal), `[H Jᵀ; J 0]`. Numbered so that
 //! every edge comes after the particles it joins, each pivot is of one sign — a
 //! particle's positive, an edge's negative — and the factorization needs no pivoting.
 //! An edge whose pivot vanishes depends on edges eliminated before it (a braced
 //! square); its unknown is dropped (its multiplier is zero) and the others are solved.
 //!
-//! Up-looking (Davis's LDL): row k of L is the sparse triangular solve over the
-//! elimination tree's row subtree. The symbolic phase (tree and column counts) runs once
-//! per pattern; the numeric phase allocates nothing once sized.
+//! The tree and the counts are Davis's LDL's symbolic phase; its up-looking numeric
+//! phase (row k of L the sparse triangular solve over the tree's row subtree) is the
+//! reference.
 
 /// No parent in the elimination tree.
 const ROOT: u32 = u32::MAX;
 
 /// A pivot below this fraction of its scale marks a dependent constraint.
+#[cfg(test)]
 const DEPENDENT_PIVOT: f64 = 1e-10;
 
 /// The pattern of a symmetric matrix's upper triangle, by column, and its elimination
@@ -32,7 +35,8 @@ pub struct LdlPattern {
     l_start: Vec<u32>,
 }
 
-/// The numeric factor `L D Lᵀ` and the buffers that make it.
+/// The numeric factor `L D Lᵀ`, column by column, and the buffers that make it.
+#[cfg(test)]
 #[derive(Clone, Debug, Default)]
 pub struct LdlFactor {
     l_row: Vec<u32>,
@@ -56,6 +60,17 @@ pub struct BadPivot {
 }
 
 impl LdlPattern {
+    /// The analysed pattern whose column k holds rows `row[start[k]..start[k + 1]]`.
+    pub fn new(start: Vec<u32>, row: Vec<u32>) -> LdlPattern {
+        let mut p = LdlPattern {
+            start,
+            row,
+            ..Default::default()
+        };
+        p.analyze(&mut Vec::new());
+        p
+    }
+
     /// Unknowns.
     pub fn len(&self) -> usize {
         self.start.len().saturating_sub(1)
@@ -69,6 +84,17 @@ impl LdlPattern {
     /// Values stored (the matrix's upper triangle).
     pub fn values(&self) -> usize {
         self.row.len()
+    }
+
+    /// Each unknown's parent in the elimination tree (`u32::MAX` for a root).
+    pub fn parent(&self) -> &[u32] {
+        &self.parent
+    }
+
+    /// Each column's non-zeros below the diagonal in the factor, into `count`.
+    pub fn column_counts_into(&self, count: &mut Vec<u32>) {
+        count.clear();
+        count.extend(self.l_start.windows(2).map(|w| w[1] - w[0]));
     }
 
     /// The factorization's work: Σ over columns of (non-zeros below the diagonal)².
@@ -115,6 +141,7 @@ impl LdlPattern {
     }
 }
 
+#[cfg(test)]
 impl LdlFactor {
     /// Factor the matrix with pattern `p` and values `value` (aligned with `p.row`).
     /// `scale[k]` is unknown k's natural pivot size: a pivot below

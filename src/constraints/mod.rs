@@ -19,6 +19,7 @@ pub mod projection;
 pub mod relaxation;
 pub mod solver;
 pub mod sparse;
+pub mod supernodal;
 pub mod tridiagonal;
 
 pub use plugin::{ConstraintsPlugin, Islands};

@@ -14,7 +14,8 @@
 use bevy::math::DVec2;
 
 use super::joint_state::JointRow;
-use crate::constraints::ldl::{BadPivot, LdlFactor, LdlPattern};
+use crate::constraints::ldl::{BadPivot, LdlPattern};
+use crate::constraints::supernodal::{SupernodalFactor, SupernodalPlan};
 
 /// Not an unknown (a fixed particle, a locked edge).
 pub(super) const NONE: u32 = u32::MAX;
@@ -78,7 +79,8 @@ pub(super) struct Kkt {
     pattern: LdlPattern,
     flag: Vec<u32>,
     value: Vec<f64>,
-    factor: LdlFactor,
+    plan: SupernodalPlan,
+    factor: SupernodalFactor,
     /// Factorizations since the last [`Kkt::number`].
     pub(super) factorizations: u32,
 }
@@ -106,6 +108,7 @@ impl Kkt {
         self.assign(input);
         self.contributions(input);
         self.pattern.analyze(&mut self.flag);
+        self.plan.plan(&self.pattern);
     }
 
     /// The particles' elimination order: approximate minimum degree (Amestoy, Davis
@@ -429,12 +432,12 @@ impl Kkt {
         }
         self.factorizations += 1;
         self.factor
-            .factor(&self.pattern, &self.value, &self.scale, &self.negative)
+            .factor(&self.plan, &self.value, &self.scale, &self.negative)
     }
 
     /// Solve the last factored system for `x` in place.
     pub(super) fn solve(&self, x: &mut [f64]) {
-        self.factor.solve(&self.pattern, x);
+        self.factor.solve(&self.plan, x);
     }
 
     /// The factorization's work (Σ of the factor's column counts squared) for the last
