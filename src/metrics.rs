@@ -50,6 +50,10 @@ pub struct IterationStats {
     pub capped: u64,
     /// Solves whose corrections were too large to apply and were dropped.
     pub rejected: u64,
+    /// Joint projections whose rows the contact Newton solved (the rest were swept).
+    pub newton_solves: u64,
+    /// The contact Newton's sparse factorizations.
+    pub factorizations: u64,
 }
 
 impl IterationStats {
@@ -69,6 +73,14 @@ impl IterationStats {
         self.max = self.max.max(other.max);
         self.capped += other.capped;
         self.rejected += other.rejected;
+        self.newton_solves += other.newton_solves;
+        self.factorizations += other.factorizations;
+    }
+
+    /// Record a joint projection's factorizations (none: its rows were swept).
+    pub fn record_factorizations(&mut self, factorizations: u32) {
+        self.newton_solves += u64::from(factorizations > 0);
+        self.factorizations += u64::from(factorizations);
     }
 
     /// Mean iterations per solve (0 before any solve).

@@ -70,6 +70,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/pile.ron"),
     },
     BuiltinScene {
+        name: "rope_coil",
+        file: "assets/scenes/rope_coil.ron",
+        text: include_str!("../../assets/scenes/rope_coil.ron"),
+    },
+    BuiltinScene {
         name: "sandbox",
         file: "assets/scenes/sandbox.ron",
         text: include_str!("../../assets/scenes/sandbox.ron"),

@@ -123,6 +123,11 @@ pub struct Report {
     pub contact_projection_capped_solves: u64,
     /// Re-projections in contact dropped because they asked for absurd corrections.
     pub contact_projection_rejected_solves: u64,
+    /// Projections in contact whose rows the contact Newton solved (the others were
+    /// swept), and its factorizations.
+    pub contact_projection_newton_solves: u64,
+    /// The contact Newton's sparse factorizations.
+    pub contact_projection_factorizations: u64,
     /// Steps whose collisions still needed impulses after the last re-projection:
     /// edges next to those contacts end the step as the impulses left them.
     pub contact_unsettled_steps: u64,
@@ -205,8 +210,10 @@ impl Report {
             (
                 "contact_projection",
                 format!(
-                    "{} solves, mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
+                    "{} solves ({} by Newton, {} factorizations), mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
                     self.contact_projection_solves,
+                    self.contact_projection_newton_solves,
+                    self.contact_projection_factorizations,
                     self.contact_projection_iterations_mean,
                     self.contact_projection_iterations_max,
                     self.contact_projection_capped_solves,

@@ -185,6 +185,64 @@ pub enum ShapeSpec {
         /// The particles' positions.
         points: Vec<[f64; 2]>,
     },
+    /// An open strand folded in rows: from `start` (its first particle) rightwards
+    /// `width` long, then back `row_gap` lower, and so on, each row joined to the next
+    /// by a half turn; a rope laid out or dropped in coils.
+    Serpentine {
+        /// First particle: the top row's left end.
+        start: [f64; 2],
+        /// Length of a row.
+        width: f64,
+        /// Distance from one row to the next.
+        row_gap: f64,
+        /// Particle count.
+        particles: usize,
+        /// Rest spacing along the rows (the turns' is the same, to within a rounding).
+        spacing: f64,
+    },
+}
+
+/// The particles of a [`ShapeSpec::Serpentine`].
+pub fn serpentine_points(
+    start: DVec2,
+    width: f64,
+    row_gap: f64,
+    particles: usize,
+    spacing: f64,
+) -> Vec<DVec2> {
+    let per_row = (width / spacing).floor() as usize + 1;
+    let radius = 0.5 * row_gap;
+    let turn = ((std::f64::consts::PI * radius / spacing).round() as usize).max(2);
+    let mut points = Vec::with_capacity(particles);
+    let mut y = start.y;
+    let mut rightwards = true;
+    while points.len() < particles {
+        for i in 0..per_row {
+            let along = if rightwards { i } else { per_row - 1 - i };
+            points.push(DVec2::new(start.x + along as f64 * spacing, y));
+            if points.len() == particles {
+                return points;
+            }
+        }
+        let (end, side) = if rightwards {
+            (start.x + (per_row - 1) as f64 * spacing, 1.0)
+        } else {
+            (start.x, -1.0)
+        };
+        for k in 1..turn {
+            let angle = std::f64::consts::PI * k as f64 / turn as f64;
+            points.push(DVec2::new(
+                end + side * radius * angle.sin(),
+                y - radius + radius * angle.cos(),
+            ));
+            if points.len() == particles {
+                return points;
+            }
+        }
+        y -= row_gap;
+        rightwards = !rightwards;
+    }
+    points
 }
 
 /// A strand in a scenario file.
@@ -267,6 +325,19 @@ impl StrandSpec {
             ShapeSpec::Polygon { points } => {
                 StrandBuilder::closed_loop(points.iter().map(|&p| vec2(p)))
             }
+            &ShapeSpec::Serpentine {
+                start,
+                width,
+                row_gap,
+                particles,
+                spacing,
+            } => StrandBuilder::polyline(serpentine_points(
+                vec2(start),
+                width,
+                row_gap,
+                particles,
+                spacing,
+            )),
         };
         let mut builder = builder
             .mass(self.mass)
@@ -310,6 +381,26 @@ impl StrandSpec {
             ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => {
                 for (j, &p) in points.iter().enumerate() {
                     finite_vector(&format!("shape.points[{j}]"), vec2(p)).map_err(at)?;
+                }
+            }
+            ShapeSpec::Serpentine {
+                start,
+                width,
+                row_gap,
+                particles,
+                spacing,
+            } => {
+                finite_vector("shape.start", vec2(*start)).map_err(at)?;
+                at_least("shape.particles", *particles, 2, "a strand").map_err(at)?;
+                positive("shape.spacing", *spacing).map_err(at)?;
+                positive("shape.row_gap", *row_gap).map_err(at)?;
+                if !(width.is_finite() && *width >= *spacing) {
+                    return Err((
+                        ".shape.width".into(),
+                        format!(
+                            "{width} is shorter than one spacing ({spacing}); a row needs two particles"
+                        ),
+                    ));
                 }
             }
         }
@@ -380,6 +471,7 @@ impl Scenario {
         let strands = self.strands.iter().map(|s| match &s.shape {
             ShapeSpec::Line { particles, .. } => *particles,
             ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => points.len(),
+            ShapeSpec::Serpentine { particles, .. } => *particles,
         });
         let scale = self.scale.map(|s| s.strands.saturating_mul(s.particles));
         let fur =

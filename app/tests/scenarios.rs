@@ -119,6 +119,35 @@ fn the_dense_pile_lands_at_its_default_step_uncrossed_and_exact() {
 }
 
 #[test]
+fn the_coiling_rope_is_solved_by_the_contact_newton_uncrossed_and_exact() {
+    // A 1 000-particle rope dropped in rows: by 0.7 s its lower rows have landed on the
+    // floor and the next ones on them. Its rows touch one strand as long as the rope,
+    // so the joint projections go to the contact Newton, not to the sweeps.
+    let report = run_ok(&options("rope_coil", 0.7));
+    assert_eq!(
+        report.edge_crossings,
+        Some(0),
+        "{:?}",
+        report.first_crossing
+    );
+    assert!(
+        report.max_rel_length_error < 1e-9,
+        "{:e}",
+        report.max_rel_length_error
+    );
+    assert!(report.contacts > 10_000, "{}", report.contacts);
+    assert!(
+        report.contact_projection_newton_solves == report.contact_projection_solves
+            && report.contact_projection_factorizations >= report.contact_projection_solves,
+        "{} of {} by Newton, {} factorizations",
+        report.contact_projection_newton_solves,
+        report.contact_projection_solves,
+        report.contact_projection_factorizations
+    );
+    assert_eq!(report.failsafe_steps, 0);
+}
+
+#[test]
 fn branches_solves_its_trees_and_graphs_exactly() {
     // One second: the ladder is thrown into the trees and falls back on the truss.
     let report = run_ok(&options("branches", 1.0));

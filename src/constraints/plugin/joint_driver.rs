@@ -351,6 +351,7 @@ impl Lane {
             residual: outcome.residual,
             ..Default::default()
         });
+        self.stats.record_factorizations(outcome.factorizations);
         self.total.iterations = self.total.iterations.max(outcome.iterations);
         self.total.sweeps += outcome.sweeps;
         self.total.converged &= outcome.converged;

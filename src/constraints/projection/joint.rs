@@ -1017,6 +1017,103 @@ mod tests {
     }
 
     #[test]
+    fn a_long_strand_folded_onto_itself_is_projected_by_newton_no_farther_than_by_the_sweeps() {
+        // One strand of 200 particles folded in two, its upper half falling onto its
+        // lower half lying on a pinned floor: every row couples two far apart stretches
+        // of the same strand (a response as long as the strand, for the sweeps; three
+        // particles, for Newton). Frictionless: both must meet every row and edge.
+        let n = 200;
+        let half = n / 2;
+        let mut position: Vec<DVec2> = (0..half)
+            .map(|i| DVec2::new(0.01 * i as f64, 0.004))
+            .collect();
+        position.push(DVec2::new(0.01 * half as f64 + 0.002, 0.006));
+        position.extend((1..half).map(|i| DVec2::new(0.01 * (half - i) as f64 - 0.005, 0.0085)));
+        let mut pairs: Vec<(u32, u32)> = (0..n as u32 - 1).map(|i| (i, i + 1)).collect();
+        position.extend([DVec2::new(-1.0, 0.0), DVec2::new(2.0, 0.0)]);
+        pairs.push((n as u32, n as u32 + 1));
+        let world = World::new(position, &pairs, &[n, n + 1]);
+        let dt = 1.0 / 300.0;
+        let mut rows = Vec::new();
+        // The lower half on the floor, and the upper half on the lower half.
+        for p in 0..half {
+            rows.push(row(&world, pair(p, n, n + 1, 0.5), DVec2::Y, 0.004, dt));
+        }
+        for p in half + 1..n {
+            let x = world.position[p].x;
+            let below = ((x / 0.01).floor() as usize).min(half - 2);
+            let alpha = (x - 0.01 * below as f64) / 0.01;
+            rows.push(row(
+                &world,
+                pair(p, below, below + 1, alpha),
+                DVec2::Y,
+                0.004,
+                dt,
+            ));
+        }
+        let start: Vec<DVec2> = (0..n + 2)
+            .map(|p| {
+                if p >= half && p < n {
+                    DVec2::new(0.1, -0.6)
+                } else if p < n {
+                    DVec2::new(0.1, -0.05)
+                } else {
+                    DVec2::ZERO
+                }
+            })
+            .collect();
+        let mut results = Vec::new();
+        for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
+            let mut velocity = start.clone();
+            let mut impulses = vec![RowImpulse::default(); rows.len()];
+            let settings = JointSettings {
+                solver,
+                sweeps: 4000,
+                contact_tolerance: 1e-10,
+                ..settings()
+            };
+            let islands: Vec<u32> = (0..world.set.islands.len() as u32).collect();
+            let outcome = project_jointly(
+                &world.set,
+                &islands,
+                &[],
+                Bodies::new(&world.position, &mut velocity, &world.inverse_mass),
+                &rows,
+                &mut impulses,
+                dt,
+                &settings,
+                &mut JointScratch::default(),
+            );
+            assert!(outcome.converged, "{solver:?}: {outcome:?}");
+            assert!(world.max_relative_error(&velocity, dt) < 1e-12);
+            assert!(shortfall(&rows, &velocity, dt) <= 1e-9, "{solver:?}");
+            let (after, before) = (world.momentum(&velocity), world.momentum(&start));
+            // The floor takes the strand's weight; sideways, nothing acts.
+            assert!(
+                (after.x - before.x).abs() < 1e-12,
+                "{solver:?}: {after} {before}"
+            );
+            results.push((velocity, outcome));
+        }
+        let (swept, newton) = (&results[0], &results[1]);
+        assert!(newton.1.factorizations > 0 && swept.1.sweeps > 0);
+        // Both end on the edges' manifold with the rows met; the projection is the
+        // motion nearest the prediction in kinetic energy, and Newton, minimizing just
+        // that, ends no farther from it than the sweeps do.
+        let distance = |v: &[DVec2]| -> f64 {
+            (v.iter().zip(&start).zip(&world.inverse_mass))
+                .filter(|(_, w)| **w > 0.0)
+                .map(|((v, s), w)| (*v - *s).length_squared() / w)
+                .sum()
+        };
+        let (d_swept, d_newton) = (distance(&swept.0), distance(&newton.0));
+        assert!(
+            d_newton <= d_swept * (1.0 + 1e-6),
+            "{d_newton} against {d_swept}"
+        );
+    }
+
+    #[test]
     fn rows_that_cannot_all_be_met_are_frozen_and_the_edges_still_exact() {
         // The middle particle of a strand squeezed between two pinned walls 5 mm apart,
         // each asking for 4 mm: no impulses meet both rows, and Gauss–Seidel only trades
