@@ -51,8 +51,11 @@ pub struct IterationStats {
     /// Solves whose corrections were too large to apply and were dropped.
     pub rejected: u64,
     /// Joint projections whose rows the contact Newton solved (the rest were swept).
+    /// (Snapshots from before it read 0.)
+    #[cfg_attr(feature = "serde", serde(default))]
     pub newton_solves: u64,
     /// The contact Newton's sparse factorizations.
+    #[cfg_attr(feature = "serde", serde(default))]
     pub factorizations: u64,
 }
 
