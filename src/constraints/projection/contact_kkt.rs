@@ -63,9 +63,12 @@ pub(super) struct Kkt {
     compact: Vec<u32>,
     graph_start: Vec<u32>,
     graph_neighbour: Vec<u32>,
-    /// The graph the particles were last ordered for, and their order.
+    /// The graph the particles were last ordered for (with its diagonal), the graph
+    /// of this call in the same form, and the order.
     ordered_start: Vec<i32>,
     ordered_neighbour: Vec<i32>,
+    asked_start: Vec<i32>,
+    asked_neighbour: Vec<i32>,
     order: Vec<u32>,
     pairs: Vec<(u32, u32)>,
     fill: Vec<u32>,
@@ -115,22 +118,31 @@ impl Kkt {
     /// and Duff), half the fill a geometric nested dissection left on a dropped pile's
     /// groups. The ordering allocates, so the last graph's order is kept and reused
     /// while the graph is the same (a resting contact's from step to step). The graph
-    /// is symmetric, sorted and without self-loops, as the ordering asks; on the one
+    /// is symmetric and sorted, as the ordering asks; on the one
     /// error it reports (a malformed graph), the particles keep their order.
     fn order_particles(&mut self) {
         let m = self.free.len();
-        let same = self.ordered_start.len() == m + 1
-            && (self.ordered_start.iter().zip(&self.graph_start)).all(|(&a, &b)| a == b as i32)
-            && self.ordered_neighbour.len() == self.graph_neighbour.len()
-            && (self.ordered_neighbour.iter().zip(&self.graph_neighbour))
-                .all(|(&a, &b)| a == b as i32);
-        if same {
+        // The ordering is given every diagonal entry: it skips them, and without them a
+        // graph with fewer entries than particles underflows a check of the ordering's
+        // own in a debug build.
+        self.asked_start.clear();
+        self.asked_neighbour.clear();
+        self.asked_start.push(0);
+        for i in 0..m {
+            let row = &self.graph_neighbour
+                [self.graph_start[i] as usize..self.graph_start[i + 1] as usize];
+            let below = row.partition_point(|&j| (j as usize) < i);
+            (self.asked_neighbour).extend(row[..below].iter().map(|&j| j as i32));
+            self.asked_neighbour.push(i as i32);
+            (self.asked_neighbour).extend(row[below..].iter().map(|&j| j as i32));
+            self.asked_start.push(self.asked_neighbour.len() as i32);
+        }
+        if self.asked_start == self.ordered_start && self.asked_neighbour == self.ordered_neighbour
+        {
             return;
         }
-        self.ordered_start.clear();
-        (self.ordered_start).extend(self.graph_start.iter().map(|&x| x as i32));
-        self.ordered_neighbour.clear();
-        (self.ordered_neighbour).extend(self.graph_neighbour.iter().map(|&x| x as i32));
+        std::mem::swap(&mut self.asked_start, &mut self.ordered_start);
+        std::mem::swap(&mut self.asked_neighbour, &mut self.ordered_neighbour);
         self.order.clear();
         let control = amd::Control::default();
         match amd::order::<i32>(
