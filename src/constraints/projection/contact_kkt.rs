@@ -52,6 +52,8 @@ impl RowModel {
 /// The numbering, pattern, values and factor of the system, reused.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Kkt {
+    /// Threads the factorization may use (the joint projection's own).
+    pub(super) threads: usize,
     /// Each joint particle's x unknown (y follows), or [`NONE`] when it is fixed.
     pub(super) particle_unknown: Vec<u32>,
     /// Each joint edge's unknown, or [`NONE`] when it is locked.
@@ -443,8 +445,13 @@ impl Kkt {
             }
         }
         self.factorizations += 1;
-        self.factor
-            .factor(&self.plan, &self.value, &self.scale, &self.negative)
+        self.factor.factor(
+            &self.plan,
+            &self.value,
+            &self.scale,
+            &self.negative,
+            self.threads,
+        )
     }
 
     /// Solve the last factored system for `x` in place.

@@ -306,6 +306,7 @@ fn run(
     let n = s.packed.len();
     let rows = s.rows.len();
     w.kkt.factorizations = 0;
+    w.kkt.threads = s.threads;
     let links: usize = s.rows.iter().map(|row| row.link_count as usize).sum();
     if settings.solver == ContactSolver::Auto && responses(s) < SHORT_RESPONSES * links as f64 {
         return None;
