@@ -31,7 +31,11 @@
 
 use bevy::math::DVec2;
 
+use super::contact_cone::{
+    cone, edges, impulse, pull, push, row_motion, row_values, unknown_motion,
+};
 use super::contact_kkt::{Kkt, KktInput, NONE, RowModel};
+use super::contact_line::Line;
 use super::joint::{JointOutcome, JointSettings, measure_edges};
 use super::joint_state::{JointRow, JointScratch};
 use super::settings::{ContactSolver, ROUND_OFF_FLOOR};
@@ -93,50 +97,6 @@ pub(super) struct NewtonScratch {
     feasible: Vec<f64>,
 }
 
-/// The edges of a row's cone in its (normal, tangent) plane; without friction one
-/// edge, the normal (the second is then unused).
-fn cone(friction: f64) -> [(f64, f64); 2] {
-    let s = (1.0 + friction * friction).sqrt();
-    [(1.0 / s, friction / s), (1.0 / s, -friction / s)]
-}
-
-/// How many of a row's cone edges act.
-fn edges(friction: f64) -> usize {
-    if friction > 0.0 { 2 } else { 1 }
-}
-
-/// `Σ cᵢ d·vᵢ` along the row's normal and tangent.
-fn row_motion(row: &JointRow, v: &[DVec2]) -> (f64, f64) {
-    let (n, t) = (row.normal, row.normal.perp());
-    let (mut a, mut b) = (0.0, 0.0);
-    for &(j, c) in &row.entries[..row.count as usize] {
-        a += c * n.dot(v[j as usize]);
-        b += c * t.dot(v[j as usize]);
-    }
-    (a, b)
-}
-
-/// A row's normal and tangent values `slack + Σ cᵢ d·Δᵢ` for corrections `delta`.
-fn row_values(row: &JointRow, delta: &[DVec2]) -> (f64, f64) {
-    let (a, b) = row_motion(row, delta);
-    (row.slack_n + a, row.slack_t + b)
-}
-
-/// A row's motion along its normal and tangent for the particle unknowns in `x`.
-fn unknown_motion(row: &JointRow, particle_unknown: &[u32], x: &[f64]) -> (f64, f64) {
-    let (n, t) = (row.normal, row.normal.perp());
-    let (mut a, mut b) = (0.0, 0.0);
-    for &(j, c) in &row.entries[..row.count as usize] {
-        let u = particle_unknown[j as usize];
-        if u != NONE {
-            let d = DVec2::new(x[u as usize], x[u as usize + 1]);
-            a += c * n.dot(d);
-            b += c * t.dot(d);
-        }
-    }
-    (a, b)
-}
-
 /// Row `r`'s cone values at corrections `delta`, shifted by its impulses and with its
 /// normal value lifted by what its sliding asked of it last time (see [`run`]).
 fn cone_values(row: &JointRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> [f64; 2] {
@@ -144,100 +104,6 @@ fn cone_values(row: &JointRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> 
     let un = un + w.lift[r];
     let e = cone(row.friction);
     [0, 1].map(|x| e[x].0 * un + e[x].1 * ut - w.shift[r][x])
-}
-
-/// The (normal, tangent) impulse of cone impulses `lambda`.
-fn impulse(friction: f64, lambda: [f64; 2]) -> (f64, f64) {
-    let e = cone(friction);
-    let mut out = (0.0, 0.0);
-    for (edge, l) in e.iter().zip(lambda).take(edges(friction)) {
-        out.0 += l * edge.0;
-        out.1 += l * edge.1;
-    }
-    out
-}
-
-/// Add `row`'s impulse `(normal, tangent)` to the particles' impulses `p`.
-fn push(row: &JointRow, impulse: (f64, f64), p: &mut [DVec2]) {
-    let direction = impulse.0 * row.normal + impulse.1 * row.normal.perp();
-    for &(j, c) in &row.entries[..row.count as usize] {
-        p[j as usize] += c * direction;
-    }
-}
-
-/// Add `tension` of the edge from `a` to `b` along `d` to `p`: it pulls the ends
-/// together.
-fn pull(a: u32, b: u32, d: DVec2, tension: f64, p: &mut [DVec2]) {
-    p[a as usize] += tension * d;
-    p[b as usize] -= tension * d;
-}
-
-/// The line of one Newton step: the objective's derivative and slope along it.
-struct Line<'a> {
-    rows: &'a [JointRow],
-    stiffness: &'a [f64],
-    value: &'a [[f64; 2]],
-    slope: &'a [[f64; 2]],
-    /// `Σ Pa·W Pb` and `Σ Pb·W Pb` of the masses' term.
-    mass: (f64, f64),
-}
-
-impl Line<'_> {
-    /// `f'(α)` and `f''(α⁺)`.
-    fn derivative(&self, alpha: f64) -> (f64, f64) {
-        let (mut d, mut dd) = (self.mass.0 + alpha * self.mass.1, self.mass.1);
-        for (r, row) in self.rows.iter().enumerate() {
-            let k = self.stiffness[r];
-            if k == 0.0 {
-                continue;
-            }
-            for e in 0..edges(row.friction) {
-                let v = self.slope[r][e];
-                let u = self.value[r][e] + alpha * v;
-                if u < 0.0 || (u == 0.0 && v < 0.0) {
-                    d += k * u * v;
-                    dd += k * v * v;
-                }
-            }
-        }
-        (d, dd)
-    }
-
-    /// The minimizer of the convex piecewise-quadratic objective on `[0, high]`.
-    fn minimize(&self, high: f64) -> f64 {
-        let (g0, mut s_lo) = self.derivative(0.0);
-        if g0 >= 0.0 {
-            return 0.0;
-        }
-        // Within round-off of a flat derivative, the far end is the answer.
-        let (mut g_hi, _) = self.derivative(high);
-        if g_hi <= 1e-9 * g0.abs() {
-            return high;
-        }
-        let (mut lo, mut hi, mut g_lo) = (0.0, high, g0);
-        for _ in 0..60 {
-            let mut alpha = if s_lo > 0.0 { lo - g_lo / s_lo } else { hi };
-            if !(alpha > lo && alpha < hi) {
-                alpha = lo - g_lo * (hi - lo) / (g_hi - g_lo);
-            }
-            if !(alpha > lo && alpha < hi) {
-                break;
-            }
-            let (g, s) = self.derivative(alpha);
-            if g.abs() <= 1e-14 * g0.abs() {
-                return alpha;
-            }
-            if g < 0.0 {
-                (lo, g_lo, s_lo) = (alpha, g, s);
-            } else {
-                (hi, g_hi) = (alpha, g);
-            }
-            if hi - lo <= 1e-15 * high {
-                break;
-            }
-        }
-        0.5 * (lo + hi)
-    }
 }
 
 /// Solve the rows and edges of the laid-out joint projection in `s` together, from

@@ -31,7 +31,9 @@
 //! loop is in `newton`, the assembly and solve of the system in `assembly`.
 
 mod assembly;
+mod contact_cone;
 mod contact_kkt;
+mod contact_line;
 mod contact_newton;
 mod contact_rows;
 mod joint;
