@@ -18,6 +18,7 @@ pub mod report;
 pub mod runner;
 pub mod scenario;
 pub mod scenes;
+pub mod shape;
 pub mod snapshot;
 pub mod spawn;
 #[cfg(feature = "render")]

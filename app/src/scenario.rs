@@ -21,6 +21,7 @@ use crate::scenes::drain::DrainSpec;
 use crate::scenes::furry_creature::FurryCreatureSpec;
 use crate::scenes::meatball_factory::MeatballFactorySpec;
 use crate::scenes::spaghetti_factory::SpaghettiFactorySpec;
+pub use crate::shape::{ShapeSpec, serpentine_points};
 
 /// A problem with a scenario file: which file, which item in it, and what is wrong.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -160,91 +161,6 @@ pub struct ContainerSpec {
     pub max: [f64; 2],
 }
 
-/// The shape a strand starts in.
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub enum ShapeSpec {
-    /// A straight open strand from `start` at `angle_degrees` from the +x axis.
-    Line {
-        /// First particle.
-        start: [f64; 2],
-        /// Direction, degrees counter-clockwise from +x.
-        angle_degrees: f64,
-        /// Particle count.
-        particles: usize,
-        /// Rest spacing.
-        spacing: f64,
-    },
-    /// An open strand through the points.
-    Polyline {
-        /// The particles' positions.
-        points: Vec<[f64; 2]>,
-    },
-    /// A closed loop through the points, keeping their shape at rest.
-    Polygon {
-        /// The particles' positions.
-        points: Vec<[f64; 2]>,
-    },
-    /// An open strand folded in rows: from `start` (its first particle) rightwards
-    /// `width` long, then back `row_gap` lower, and so on, each row joined to the next
-    /// by a half turn; a rope laid out or dropped in coils.
-    Serpentine {
-        /// First particle: the top row's left end.
-        start: [f64; 2],
-        /// Length of a row.
-        width: f64,
-        /// Distance from one row to the next.
-        row_gap: f64,
-        /// Particle count.
-        particles: usize,
-        /// Rest spacing along the rows (the turns' is the same, to within a rounding).
-        spacing: f64,
-    },
-}
-
-/// The particles of a [`ShapeSpec::Serpentine`].
-pub fn serpentine_points(
-    start: DVec2,
-    width: f64,
-    row_gap: f64,
-    particles: usize,
-    spacing: f64,
-) -> Vec<DVec2> {
-    let per_row = (width / spacing).floor() as usize + 1;
-    let radius = 0.5 * row_gap;
-    let turn = ((std::f64::consts::PI * radius / spacing).round() as usize).max(2);
-    let mut points = Vec::with_capacity(particles);
-    let mut y = start.y;
-    let mut rightwards = true;
-    while points.len() < particles {
-        for i in 0..per_row {
-            let along = if rightwards { i } else { per_row - 1 - i };
-            points.push(DVec2::new(start.x + along as f64 * spacing, y));
-            if points.len() == particles {
-                return points;
-            }
-        }
-        let (end, side) = if rightwards {
-            (start.x + (per_row - 1) as f64 * spacing, 1.0)
-        } else {
-            (start.x, -1.0)
-        };
-        for k in 1..turn {
-            let angle = std::f64::consts::PI * k as f64 / turn as f64;
-            points.push(DVec2::new(
-                end + side * radius * angle.sin(),
-                y - radius + radius * angle.cos(),
-            ));
-            if points.len() == particles {
-                return points;
-            }
-        }
-        y -= row_gap;
-        rightwards = !rightwards;
-    }
-    points
-}
-
 /// A strand in a scenario file.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -309,36 +225,7 @@ pub(crate) fn vec2(v: [f64; 2]) -> DVec2 {
 impl StrandSpec {
     /// The builder this spec describes (not yet validated).
     pub fn builder(&self) -> StrandBuilder {
-        let builder = match &self.shape {
-            ShapeSpec::Line {
-                start,
-                angle_degrees,
-                particles,
-                spacing,
-            } => {
-                let direction = DVec2::from_angle(angle_degrees.to_radians());
-                StrandBuilder::line(vec2(*start), direction, *particles, *spacing)
-            }
-            ShapeSpec::Polyline { points } => {
-                StrandBuilder::polyline(points.iter().map(|&p| vec2(p)))
-            }
-            ShapeSpec::Polygon { points } => {
-                StrandBuilder::closed_loop(points.iter().map(|&p| vec2(p)))
-            }
-            &ShapeSpec::Serpentine {
-                start,
-                width,
-                row_gap,
-                particles,
-                spacing,
-            } => StrandBuilder::polyline(serpentine_points(
-                vec2(start),
-                width,
-                row_gap,
-                particles,
-                spacing,
-            )),
-        };
+        let builder = self.shape.builder();
         let mut builder = builder
             .mass(self.mass)
             .velocity(vec2(self.velocity))
@@ -359,51 +246,7 @@ impl StrandSpec {
     /// field (with a leading `.`, or empty for the strand as a whole) and the problem.
     fn validate(&self) -> Result<(), (String, String)> {
         let at = |e: NumberError| (format!(".{}", e.field), e.problem);
-        match &self.shape {
-            ShapeSpec::Line {
-                start,
-                angle_degrees,
-                particles,
-                spacing,
-            } => {
-                finite_vector("shape.start", vec2(*start)).map_err(at)?;
-                finite("shape.angle_degrees", *angle_degrees).map_err(at)?;
-                at_least("shape.particles", *particles, 2, "a strand").map_err(at)?;
-                if !(spacing.is_finite() && *spacing > 0.0) {
-                    return Err((
-                        ".shape.spacing".into(),
-                        format!(
-                            "{spacing} would make a zero or negative rest length; it must be positive"
-                        ),
-                    ));
-                }
-            }
-            ShapeSpec::Polyline { points } | ShapeSpec::Polygon { points } => {
-                for (j, &p) in points.iter().enumerate() {
-                    finite_vector(&format!("shape.points[{j}]"), vec2(p)).map_err(at)?;
-                }
-            }
-            ShapeSpec::Serpentine {
-                start,
-                width,
-                row_gap,
-                particles,
-                spacing,
-            } => {
-                finite_vector("shape.start", vec2(*start)).map_err(at)?;
-                at_least("shape.particles", *particles, 2, "a strand").map_err(at)?;
-                positive("shape.spacing", *spacing).map_err(at)?;
-                positive("shape.row_gap", *row_gap).map_err(at)?;
-                if !(width.is_finite() && *width >= *spacing) {
-                    return Err((
-                        ".shape.width".into(),
-                        format!(
-                            "{width} is shorter than one spacing ({spacing}); a row needs two particles"
-                        ),
-                    ));
-                }
-            }
-        }
+        self.shape.validate()?;
         if let Some(material) = &self.material {
             material.validate().map_err(|e| at(e.within("material")))?;
         }
