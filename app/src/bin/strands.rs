@@ -55,9 +55,10 @@ struct RunArgs {
     /// Constraint solver.
     #[arg(long, value_name = "NAME", long_help = solver_help())]
     solver: Option<String>,
-    /// Contact solver (default: the scene's): `newton` (rows and edges together, one
-    /// sparse factorization a Newton step) or `gauss-seidel` (sweeps over each row's
-    /// response on its whole strands, the earlier design).
+    /// Contact solver (default: the scene's, `auto`): `auto` (per contact group, the
+    /// sweeps on short strands and Newton on long ones), `newton` (rows and edges
+    /// together, one sparse factorization a Newton step) or `gauss-seidel` (sweeps over
+    /// each row's response on its whole strands, the earlier design).
     #[arg(long, value_name = "NAME")]
     contact_solver: Option<String>,
     /// Bending model (default: the scene's): `angle` (turning angle, explicit) or
