@@ -85,6 +85,7 @@ pub mod prelude {
     pub use crate::avian::{BodyAnchor, CollidesWithStrands, StrandsAvianPlugin};
     pub use crate::colliders::{ColliderShape, StrandCollider};
     pub use crate::collision::CollisionPlugin;
+    pub use crate::constraints::projection::ContactSolver;
     pub use crate::constraints::{ConstraintsPlugin, SolverKind};
     pub use crate::contact_events::StrandContact;
     pub use crate::guard::{FiniteGuard, NonFiniteState};
