@@ -112,3 +112,23 @@ fn the_joint_groups_shared_between_threads_give_the_same_report() {
         one.max_rel_length_error
     );
 }
+
+#[test]
+fn a_factorization_shared_between_threads_gives_the_same_report() {
+    // The coiling rope by 0.7 s: one contact group, its factorizations large enough to
+    // be cut into two runs of subtrees, one per thread.
+    let one = same_on_one_and_two_threads(|threads| RunOptions {
+        scenario: "rope_coil".into(),
+        seconds: Some(0.7),
+        threads: Some(threads),
+        check_crossings: true,
+        ..Default::default()
+    });
+    assert!(one.contact_projection_factorizations > 0);
+    assert_eq!(one.edge_crossings, Some(0));
+    assert!(
+        one.max_rel_length_error < 1e-12,
+        "{:e}",
+        one.max_rel_length_error
+    );
+}
