@@ -5,7 +5,7 @@
 use bevy::math::DVec2;
 
 use super::contact_kkt::NONE;
-use super::joint_state::JointRow;
+use super::joint_row::JointRow;
 
 /// The edges of a row's cone in its (normal, tangent) plane; without friction one
 /// edge, the normal (the second is then unused).

@@ -13,7 +13,7 @@
 
 use bevy::math::DVec2;
 
-use super::joint_state::JointRow;
+use super::joint_row::JointRow;
 use crate::constraints::ldl::{BadPivot, LdlPattern};
 use crate::constraints::supernodal::{SupernodalFactor, SupernodalPlan};
 

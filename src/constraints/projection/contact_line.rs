@@ -2,7 +2,7 @@
 //! convex piecewise quadratic objective.
 
 use super::contact_cone::edges;
-use super::joint_state::JointRow;
+use super::joint_row::JointRow;
 
 /// The line of one Newton step: the objective's derivative and slope along it.
 pub(super) struct Line<'a> {

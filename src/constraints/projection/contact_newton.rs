@@ -34,11 +34,12 @@ use bevy::math::DVec2;
 use super::contact_cone::{
     cone, edges, impulse, pull, push, row_motion, row_values, unknown_motion,
 };
-use super::contact_kkt::{Kkt, KktInput, NONE, RowModel};
+use super::contact_kkt::{KktInput, NONE, RowModel};
 use super::contact_line::Line;
-use super::joint::{JointOutcome, JointSettings, measure_edges};
-use super::joint_state::{JointRow, JointScratch};
-use super::settings::{ContactSolver, ROUND_OFF_FLOOR};
+use super::contact_scratch::NewtonScratch;
+use super::joint_row::JointRow;
+use super::joint_state::{JointScratch, measure_edges};
+use super::settings::{ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR};
 
 /// A row's contact stiffness over its own mass `1 / Σ cᵢ² wᵢ`: soft enough that a step
 /// pressing a new row is not stopped at it, stiff enough that a row pressed by impulse
@@ -56,46 +57,6 @@ const STALL: u32 = 4;
 /// Rows this many tolerances from Coulomb's law are left where they are once the whole
 /// steps are done (the sweeps stalled at two to seven).
 const CLOSE_ENOUGH: f64 = 4.0;
-
-/// The buffers of the contact Newton, reused.
-#[derive(Clone, Debug, Default)]
-pub(super) struct NewtonScratch {
-    pub(super) kkt: Kkt,
-    model: Vec<RowModel>,
-    /// Which rows the system's pattern holds.
-    included: Vec<bool>,
-    /// Which of each row's cone edges the model presses.
-    pressed: Vec<[bool; 2]>,
-    /// Each row's stiffness (zero: the row is inert).
-    stiffness: Vec<f64>,
-    /// Impulses (mass × length) on each joint particle: Δ = W P.
-    momentum: Vec<DVec2>,
-    start: Vec<DVec2>,
-    step: Vec<DVec2>,
-    /// Each row's cone impulses λ± at the iterate, at the line's start and along it.
-    lambda: Vec<[f64; 2]>,
-    start_lambda: Vec<[f64; 2]>,
-    step_lambda: Vec<[f64; 2]>,
-    /// Whether this Newton step is taken whole (see [`edge_force`]).
-    whole: bool,
-    /// Each row's shifts λ̄± / k, and its lift.
-    shift: Vec<[f64; 2]>,
-    lift: Vec<f64>,
-    /// Each joint edge's impulse (tension positive) at the iterate, the line's start
-    /// and along it.
-    tension: Vec<f64>,
-    start_tension: Vec<f64>,
-    step_tension: Vec<f64>,
-    /// Each joint edge's curvature in this step's system.
-    curvature: Vec<f64>,
-    /// Each row's shifted cone values at the line's start, their change along it, and
-    /// their values at the end of the last step when the line search stopped short.
-    value: Vec<[f64; 2]>,
-    slope: Vec<[f64; 2]>,
-    ahead: Vec<[f64; 2]>,
-    full: Vec<f64>,
-    feasible: Vec<f64>,
-}
 
 /// Row `r`'s cone values at corrections `delta`, shifted by its impulses and with its
 /// normal value lifted by what its sliding asked of it last time (see [`run`]).

@@ -28,52 +28,15 @@ use bevy::math::DVec2;
 use super::contact_rows::{ContactRow, RowImpulse};
 use super::joint_rows::{Sweeps, localize_rows};
 use super::joint_split::Members;
-use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part};
+use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part, measure_edges};
 use super::scratch::Factors;
-use super::settings::{ConstraintDirection, ContactSolver, ProjectionSettings, ROUND_OFF_FLOOR};
+use super::settings::{
+    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR,
+};
 use super::view::{Bodies, IslandView};
 use super::walk::{ChainWalk, GraphWalk, Walk};
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::islands::IslandSet;
-
-/// How a joint projection is asked to stop.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct JointSettings {
-    /// The edges' tolerance and the cap on Newton steps (the direction is always the
-    /// end-of-step one).
-    pub projection: ProjectionSettings,
-    /// Gauss–Seidel sweeps over the rows per Newton step, at most.
-    pub sweeps: u32,
-    /// How far (a distance per step) a normal row may fall short of its target.
-    pub contact_tolerance: f64,
-    /// A part whose corrections would move a particle by more than this many of its
-    /// shortest rest lengths keeps its velocities (infinite: no guard): nearly
-    /// dependent rows can ask for absurd corrections.
-    pub max_correction: f64,
-    /// Rows that keep the edges from settling for this many Newton steps give way
-    /// (frozen, the edges polished alone in the steps left); the cap holds them
-    /// otherwise.
-    pub rows_give_way: u32,
-    /// How the rows' impulses are found.
-    pub solver: ContactSolver,
-}
-
-/// How a joint projection ended.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct JointOutcome {
-    /// Newton steps.
-    pub iterations: u32,
-    /// Gauss–Seidel sweeps over the rows, summed over the Newton steps.
-    pub sweeps: u32,
-    /// Whether every island met its edges.
-    pub converged: bool,
-    /// Final `max |C_k| / L_k²` over every island.
-    pub residual: f64,
-    /// How far (a distance per step) the most violated normal row falls short.
-    pub contact_violation: f64,
-    /// Sparse factorizations of the contact Newton.
-    pub factorizations: u32,
-}
 
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
 /// polished alone (if what the rows fall short allows no less): the polish then moves
@@ -404,28 +367,6 @@ fn iterate(
     outcome
 }
 
-/// The edges at the current corrections, their constraint values and each part's
-/// residual; returns the largest.
-pub(super) fn measure_edges(s: &mut JointScratch) -> f64 {
-    let mut largest = 0.0f64;
-    for part in &mut s.parts {
-        let (first, count) = (part.edges.0 as usize, part.edges.1 as usize);
-        let mut residual = 0.0f64;
-        for k in first..first + count {
-            let (a, b) = s.ends[k];
-            let d = s.predicted_edge[k] + (s.correction[b as usize] - s.correction[a as usize]);
-            s.edge[k] = d;
-            s.constraint[k] = d.length_squared() - s.rest_squared[k];
-            if !s.locked[k] {
-                residual = residual.max(s.constraint[k].abs() / s.rest_squared[k]);
-            }
-        }
-        part.residual = residual;
-        largest = largest.max(residual);
-    }
-    largest
-}
-
 /// Each part's Newton correction of its edges alone, into `s.base`, its factor kept
 /// for the rows' responses.
 fn edge_step(set: &IslandSet, islands: &[u32], s: &mut JointScratch) {
@@ -502,6 +443,7 @@ fn solve_part<W: Walk>(p: usize, walk: W, s: &mut JointScratch) -> bool {
 mod tests {
     use super::*;
     use crate::constraints::islands::find_islands;
+    use crate::constraints::projection::settings::ProjectionSettings;
     use crate::model::{Edge, PointEdgePair};
 
     /// A little world: points, edges joining `pairs`, pinned points.

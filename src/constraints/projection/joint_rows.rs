@@ -13,7 +13,8 @@
 use bevy::math::DVec2;
 
 use super::contact_rows::{ContactRow, RowImpulse};
-use super::joint_state::{Bank, JointRow, JointScratch, LOOSE, NOT_JOINT, Part};
+use super::joint_row::JointRow;
+use super::joint_state::{Bank, JointScratch, LOOSE, NOT_JOINT, Part};
 use super::scratch::Factors;
 use super::view::IslandView;
 use super::walk::{ChainWalk, GraphWalk, Walk};

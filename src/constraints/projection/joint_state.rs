@@ -3,7 +3,8 @@
 
 use bevy::math::DVec2;
 
-use super::contact_newton::NewtonScratch;
+use super::contact_scratch::NewtonScratch;
+use super::joint_row::JointRow;
 use super::joint_split::JointCut;
 use super::scratch::{Factors, IslandScratch};
 
@@ -31,37 +32,6 @@ pub(super) const LOOSE: u32 = u32::MAX;
 
 /// Not a particle of the joint problem.
 pub(super) const NOT_JOINT: u32 = u32::MAX;
-
-/// A contact row in joint terms. Its normal part `Σ cᵢ n·(v + Δᵢ/dt) ≥ target` reads
-/// `slack_n + Σ cᵢ n·Δᵢ ≥ 0`; its tangent part asks for no sliding, `slack_t +
-/// Σ cᵢ t·Δᵢ = 0`, with an impulse no larger than `friction` times the normal one.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct JointRow {
-    /// `(joint particle, coefficient)` of each free particle.
-    pub(super) entries: [(u32, f64); 3],
-    pub(super) count: u8,
-    pub(super) normal: DVec2,
-    pub(super) slack_n: f64,
-    pub(super) slack_t: f64,
-    pub(super) friction: f64,
-    /// Total impulses so far, times dt (mass × length).
-    pub(super) mu_n: f64,
-    pub(super) mu_t: f64,
-    /// The totals at the start of the Newton step.
-    pub(super) start_n: f64,
-    pub(super) start_t: f64,
-    /// The row's own stiffness `N r` along the normal and the tangent, and the
-    /// tangent's response to a normal impulse.
-    pub(super) diag_n: f64,
-    pub(super) diag_t: f64,
-    pub(super) cross: f64,
-    /// Whether its responses are computed (this projection).
-    pub(super) ready: bool,
-    /// Each part the row touches: `(part, offset in particle responses, offset in
-    /// edge responses)`; the offsets are placed when the row first takes an impulse.
-    pub(super) links: [(u32, u32, u32); 2],
-    pub(super) link_count: u8,
-}
 
 /// Buffers of [`project_jointly`](super::project_jointly), reused from call to call.
 #[derive(Clone, Debug, Default)]
@@ -149,4 +119,26 @@ impl JointScratch {
         let (first, count) = self.parts[self.part_of_member[i] as usize].edges;
         &self.edge_impulse[first as usize..(first + count) as usize]
     }
+}
+
+/// The edges at the current corrections, their constraint values and each part's
+/// residual; returns the largest.
+pub(super) fn measure_edges(s: &mut JointScratch) -> f64 {
+    let mut largest = 0.0f64;
+    for part in &mut s.parts {
+        let (first, count) = (part.edges.0 as usize, part.edges.1 as usize);
+        let mut residual = 0.0f64;
+        for k in first..first + count {
+            let (a, b) = s.ends[k];
+            let d = s.predicted_edge[k] + (s.correction[b as usize] - s.correction[a as usize]);
+            s.edge[k] = d;
+            s.constraint[k] = d.length_squared() - s.rest_squared[k];
+            if !s.locked[k] {
+                residual = residual.max(s.constraint[k].abs() / s.rest_squared[k]);
+            }
+        }
+        part.residual = residual;
+        largest = largest.max(residual);
+    }
+    largest
 }

@@ -36,7 +36,9 @@ mod contact_kkt;
 mod contact_line;
 mod contact_newton;
 mod contact_rows;
+mod contact_scratch;
 mod joint;
+mod joint_row;
 mod joint_rows;
 mod joint_split;
 mod joint_state;
@@ -47,12 +49,13 @@ mod view;
 mod walk;
 
 pub use contact_rows::{ContactRow, RowImpulse};
-pub use joint::{JointOutcome, JointSettings, project_jointly};
+pub use joint::project_jointly;
 pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
 pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
 pub use settings::{
-    ConstraintDirection, ContactSolver, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
+    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ProjectionOutcome,
+    ProjectionSettings, ROUND_OFF_FLOOR,
 };
 pub use view::{Bodies, Chain, Graph, IslandView};
 

@@ -102,3 +102,42 @@ pub struct ProjectionOutcome {
 /// coordinate differences, so f64 resolves them to a few ulps of their own length and
 /// asking for less would only spin.
 pub const ROUND_OFF_FLOOR: f64 = 16.0 * f64::EPSILON;
+
+/// How a joint projection is asked to stop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointSettings {
+    /// The edges' tolerance and the cap on Newton steps (the direction is always the
+    /// end-of-step one).
+    pub projection: ProjectionSettings,
+    /// Gauss–Seidel sweeps over the rows per Newton step, at most.
+    pub sweeps: u32,
+    /// How far (a distance per step) a normal row may fall short of its target.
+    pub contact_tolerance: f64,
+    /// A part whose corrections would move a particle by more than this many of its
+    /// shortest rest lengths keeps its velocities (infinite: no guard): nearly
+    /// dependent rows can ask for absurd corrections.
+    pub max_correction: f64,
+    /// Rows that keep the edges from settling for this many Newton steps give way
+    /// (frozen, the edges polished alone in the steps left); the cap holds them
+    /// otherwise.
+    pub rows_give_way: u32,
+    /// How the rows' impulses are found.
+    pub solver: ContactSolver,
+}
+
+/// How a joint projection ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointOutcome {
+    /// Newton steps.
+    pub iterations: u32,
+    /// Gauss–Seidel sweeps over the rows, summed over the Newton steps.
+    pub sweeps: u32,
+    /// Whether every island met its edges.
+    pub converged: bool,
+    /// Final `max |C_k| / L_k²` over every island.
+    pub residual: f64,
+    /// How far (a distance per step) the most violated normal row falls short.
+    pub contact_violation: f64,
+    /// Sparse factorizations of the contact Newton.
+    pub factorizations: u32,
+}
