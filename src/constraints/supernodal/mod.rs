@@ -680,19 +680,24 @@ mod tests {
                 }
             }
         }
-        let n = negative.len();
-        let (mut start, mut row) = (vec![0; n + 1], Vec::new());
+        let (pattern, value) = pattern_of(negative.len(), entries);
+        (pattern, value, negative)
+    }
+
+    /// The upper pattern of `n` unknowns and its values from `(row, column, value)`
+    /// entries (`row ≤ column`, repeats allowed), by column.
+    fn pattern_of(n: usize, mut entries: Vec<(u32, u32, f64)>) -> (LdlPattern, Vec<f64>) {
         entries.sort_by_key(|e| e.1);
-        let mut value = Vec::new();
+        let (mut start, mut row, mut value) = (vec![0; n + 1], Vec::new(), Vec::new());
         for &(i, j, v) in &entries {
             start[j as usize + 1] += 1;
             row.push(i);
             value.push(v);
         }
-        for k in 0..n {
-            start[k + 1] += start[k];
+        for j in 0..n {
+            start[j + 1] += start[j];
         }
-        (LdlPattern::new(start, row), value, negative)
+        (LdlPattern::new(start, row), value)
     }
 
     #[test]
@@ -780,18 +785,7 @@ mod tests {
                 }
             }
         }
-        let n = 2 * particles;
-        entries.sort_by_key(|e| e.1);
-        let (mut start, mut row, mut value) = (vec![0; n + 1], Vec::new(), Vec::new());
-        for &(i, j, v) in &entries {
-            start[j as usize + 1] += 1;
-            row.push(i);
-            value.push(v);
-        }
-        for j in 0..n {
-            start[j + 1] += start[j];
-        }
-        (LdlPattern::new(start, row), value)
+        pattern_of(2 * particles, entries)
     }
 
     #[test]
