@@ -9,7 +9,7 @@ use avian2d::prelude::*;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 
-use crate::chain::{Chains, Grid, Segment, measure};
+use crate::chain::Chains;
 use crate::rapier_world::walls;
 use crate::report::EngineRun;
 
@@ -68,10 +68,6 @@ pub fn run(chains: &Chains, dt: f32, steps: u64, length_unit: f32) -> EngineRun 
         }
         links.push(chain);
     }
-    let rest: Vec<Vec<f32>> = links
-        .iter()
-        .map(|chain| chain.windows(2).map(|p| p[0].1.min(p[1].1)).collect())
-        .collect();
     let threads = bevy::tasks::ComputeTaskPool::get_or_init(Default::default).thread_num();
     let mut run = EngineRun::new(
         "avian2d",
@@ -79,16 +75,16 @@ pub fn run(chains: &Chains, dt: f32, steps: u64, length_unit: f32) -> EngineRun 
         length_unit,
         threads,
     );
-    let mut grid = Grid::new(0.03);
-    let mut segments: Vec<Vec<Segment>> = Vec::new();
+    let lengths: Vec<Vec<f32>> = (links.iter())
+        .map(|chain| chain.iter().map(|l| l.1).collect())
+        .collect();
     // The first update spawns avian's internal state; the clock starts after it.
     app.update();
-    for _ in 0..steps {
+    run.drive(chains, &lengths, steps, |segments| {
         let began = Instant::now();
         app.update();
-        run.wall += began.elapsed().as_secs_f64();
+        let wall = began.elapsed().as_secs_f64();
         let world = app.world();
-        segments.clear();
         segments.extend(links.iter().map(|chain| {
             chain
                 .iter()
@@ -101,12 +97,7 @@ pub fn run(chains: &Chains, dt: f32, steps: u64, length_unit: f32) -> EngineRun 
                 })
                 .collect()
         }));
-        run.record(
-            measure(&segments, &rest, &mut grid),
-            &segments,
-            chains.container,
-        );
-    }
-    run.steps = steps;
+        wall
+    });
     run
 }

@@ -167,7 +167,7 @@ fn pile(seconds: Option<f64>) {
         ..Default::default()
     };
     let scenario = load_scenario(&options).expect("the built-in pile");
-    let scale = scenario.scale.clone().expect("the pile is a scaled scene");
+    let scale = scenario.scale.expect("the pile is a scaled scene");
     let seconds = seconds.unwrap_or(scenario.duration);
     let chains = Chains::from_scale(
         &scale,
@@ -243,7 +243,7 @@ mod tests {
             ..Default::default()
         };
         let scenario = load_scenario(&options).unwrap();
-        let mut scale = scenario.scale.clone().unwrap();
+        let mut scale = scenario.scale.unwrap();
         scale.strands = 3;
         let chains = Chains::from_scale(&scale, 0.004, 0.3, 1.0);
         (chains, 0.5)

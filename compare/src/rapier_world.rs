@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use rapier2d::prelude::*;
 
-use crate::chain::{Chains, Grid, Segment, measure};
+use crate::chain::Chains;
 use crate::report::EngineRun;
 
 /// `length_unit` is Rapier's scale of contact tolerances (1 m by default; its guide
@@ -57,23 +57,19 @@ pub fn run(chains: &Chains, dt: f32, steps: u64, length_unit: f32) -> EngineRun 
         }
         handles.push(links);
     }
-    let rest: Vec<Vec<f32>> = handles
-        .iter()
-        .map(|links| links.windows(2).map(|p| p[0].1.min(p[1].1)).collect())
-        .collect();
     let mut run = EngineRun::new(
         "rapier2d",
         "revolute impulse joints, capsule links",
         length_unit,
         rapier2d::rayon::current_num_threads(),
     );
-    let mut grid = Grid::new(0.03);
-    let mut segments: Vec<Vec<Segment>> = Vec::new();
-    for _ in 0..steps {
+    let lengths: Vec<Vec<f32>> = (handles.iter())
+        .map(|links| links.iter().map(|l| l.1).collect())
+        .collect();
+    run.drive(chains, &lengths, steps, |segments| {
         let began = Instant::now();
         world.step();
-        run.wall += began.elapsed().as_secs_f64();
-        segments.clear();
+        let wall = began.elapsed().as_secs_f64();
         segments.extend(handles.iter().map(|links| {
             links
                 .iter()
@@ -85,13 +81,8 @@ pub fn run(chains: &Chains, dt: f32, steps: u64, length_unit: f32) -> EngineRun 
                 })
                 .collect()
         }));
-        run.record(
-            measure(&segments, &rest, &mut grid),
-            &segments,
-            chains.container,
-        );
-    }
-    run.steps = steps;
+        wall
+    });
     run
 }
 

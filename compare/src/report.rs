@@ -1,7 +1,7 @@
 //! One engine's run of the chains: wall time of its steps alone, and what the step
 //! ends showed.
 
-use crate::chain::{Segment, StepMeasure};
+use crate::chain::{Chains, Grid, Segment, StepMeasure, measure};
 
 pub struct EngineRun {
     pub engine: &'static str,
@@ -41,7 +41,35 @@ impl EngineRun {
         }
     }
 
-    pub fn record(
+    /// Run an engine for `steps` steps: `step` steps it once, writes each chain's links
+    /// as it left them (link lengths `lengths`, in chain order) and returns the
+    /// seconds its own step took.
+    pub fn drive(
+        &mut self,
+        chains: &Chains,
+        lengths: &[Vec<f32>],
+        steps: u64,
+        mut step: impl FnMut(&mut Vec<Vec<Segment>>) -> f64,
+    ) {
+        // A joint's gap is measured against the shorter of the two links it joins.
+        let rest: Vec<Vec<f32>> = (lengths.iter())
+            .map(|chain| chain.windows(2).map(|p| p[0].min(p[1])).collect())
+            .collect();
+        let mut grid = Grid::new(0.03);
+        let mut segments: Vec<Vec<Segment>> = Vec::new();
+        for _ in 0..steps {
+            segments.clear();
+            self.wall += step(&mut segments);
+            self.record(
+                measure(&segments, &rest, &mut grid),
+                &segments,
+                chains.container,
+            );
+        }
+        self.steps = steps;
+    }
+
+    fn record(
         &mut self,
         step: StepMeasure,
         links: &[Vec<Segment>],
