@@ -21,11 +21,17 @@ pub(super) fn edges(friction: f64) -> usize {
 
 /// `Σ cᵢ d·vᵢ` along the row's normal and tangent.
 pub(super) fn row_motion(row: &JointRow, v: &[DVec2]) -> (f64, f64) {
+    motion_of(row, |j| v[j as usize])
+}
+
+/// `Σ cᵢ d·vᵢ` along the row's normal and tangent, with `v(j)` particle j's motion.
+fn motion_of(row: &JointRow, v: impl Fn(u32) -> DVec2) -> (f64, f64) {
     let (n, t) = (row.normal, row.normal.perp());
     let (mut a, mut b) = (0.0, 0.0);
     for &(j, c) in &row.entries[..row.count as usize] {
-        a += c * n.dot(v[j as usize]);
-        b += c * t.dot(v[j as usize]);
+        let d = v(j);
+        a += c * n.dot(d);
+        b += c * t.dot(d);
     }
     (a, b)
 }
@@ -38,17 +44,17 @@ pub(super) fn row_values(row: &JointRow, delta: &[DVec2]) -> (f64, f64) {
 
 /// A row's motion along its normal and tangent for the particle unknowns in `x`.
 pub(super) fn unknown_motion(row: &JointRow, particle_unknown: &[u32], x: &[f64]) -> (f64, f64) {
-    let (n, t) = (row.normal, row.normal.perp());
-    let (mut a, mut b) = (0.0, 0.0);
-    for &(j, c) in &row.entries[..row.count as usize] {
-        let u = particle_unknown[j as usize];
-        if u != NONE {
-            let d = DVec2::new(x[u as usize], x[u as usize + 1]);
-            a += c * n.dot(d);
-            b += c * t.dot(d);
-        }
+    motion_of(row, |j| unknown_vector(particle_unknown, x, j))
+}
+
+/// Particle j's motion in the unknowns `x` (zero for a fixed particle).
+pub(super) fn unknown_vector(particle_unknown: &[u32], x: &[f64], j: u32) -> DVec2 {
+    let u = particle_unknown[j as usize];
+    if u == NONE {
+        DVec2::ZERO
+    } else {
+        DVec2::new(x[u as usize], x[u as usize + 1])
     }
-    (a, b)
 }
 
 /// The (normal, tangent) impulse of cone impulses `lambda`.

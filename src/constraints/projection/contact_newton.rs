@@ -32,7 +32,7 @@
 use bevy::math::DVec2;
 
 use super::contact_cone::{
-    cone, edges, impulse, pull, push, row_motion, row_values, unknown_motion,
+    cone, edges, impulse, pull, push, row_motion, row_values, unknown_motion, unknown_vector,
 };
 use super::contact_kkt::{KktInput, NONE, RowModel};
 use super::contact_line::Line;
@@ -518,14 +518,7 @@ fn lines(s: &JointScratch, w: &mut NewtonScratch) {
         let c = w.curvature[k];
         if c > 0.0 {
             let motion = |x: &[f64]| -> DVec2 {
-                let at = |j: u32| {
-                    let u = w.kkt.particle_unknown[j as usize];
-                    if u == NONE {
-                        DVec2::ZERO
-                    } else {
-                        DVec2::new(x[u as usize], x[u as usize + 1])
-                    }
-                };
+                let at = |j: u32| unknown_vector(&w.kkt.particle_unknown, x, j);
                 at(b) - at(a)
             };
             pull(a, b, c * motion(&w.feasible), 1.0, &mut w.start);
