@@ -93,8 +93,8 @@ const SWEEPS_OVER_FACTORIZATIONS: f64 = 20.0;
 /// factorizations: short strands in a dense pile, where each response is a few
 /// particles long and the system's fill is not. Long strands are the other way: a
 /// response is as long as its strand, a factor's column is not.
-fn prefers_sweeps(s: &JointScratch, work: f64) -> bool {
-    work > SWEEPS_OVER_FACTORIZATIONS * responses(s)
+fn prefers_sweeps(responses: f64, work: f64) -> bool {
+    work > SWEEPS_OVER_FACTORIZATIONS * responses
 }
 
 /// The particles of every row's responses: what a sweep over the rows writes.
@@ -135,7 +135,8 @@ fn run(
     w.kkt.factorizations = 0;
     w.kkt.threads = s.threads;
     let links: usize = s.rows.iter().map(|row| row.link_count as usize).sum();
-    if settings.solver == ContactSolver::Auto && responses(s) < SHORT_RESPONSES * links as f64 {
+    let swept = responses(s);
+    if settings.solver == ContactSolver::Auto && swept < SHORT_RESPONSES * links as f64 {
         return None;
     }
     w.stiffness.clear();
@@ -176,7 +177,7 @@ fn run(
     w.included.clear();
     w.included.extend(w.stiffness.iter().map(|&k| k > 0.0));
     w.kkt.number(&kkt_input(s, &w.included));
-    if settings.solver == ContactSolver::Auto && prefers_sweeps(s, w.kkt.work()) {
+    if settings.solver == ContactSolver::Auto && prefers_sweeps(swept, w.kkt.work()) {
         return None;
     }
     let tolerance = settings.contact_tolerance;
