@@ -124,7 +124,7 @@ pub struct Report {
     /// Re-projections in contact dropped because they asked for absurd corrections.
     pub contact_projection_rejected_solves: u64,
     /// Projections in contact whose rows the contact Newton solved (the others were
-    /// swept), and its factorizations.
+    /// swept).
     pub contact_projection_newton_solves: u64,
     /// The contact Newton's sparse factorizations.
     pub contact_projection_factorizations: u64,

@@ -396,9 +396,10 @@ pub struct ContactConfig {
     /// moving, rather than by impulses. Off, proximity and collision impulses do the
     /// work and the contact loop re-projects what they stretched.
     pub speculative: bool,
-    /// How a joint projection finds its rows' impulses: Newton's method on the rows
-    /// and edges together (the default), or projected Gauss–Seidel over each row's
-    /// response on its whole strands (the earlier design, a baseline).
+    /// How a joint projection finds its rows' impulses: by default (`Auto`) each
+    /// group by whichever costs it less, Newton's method on the rows and edges
+    /// together for long strands or projected Gauss–Seidel over each row's response on
+    /// its whole strands for short ones; either can be asked for.
     pub solver: ContactSolver,
 }
 
