@@ -111,8 +111,16 @@ pub fn integrate(
     mut clock: ResMut<SimulationClock>,
 ) {
     let ParticleState {
-        position, velocity, ..
+        position,
+        velocity,
+        end_velocity_change,
+        ..
     } = &mut *state;
     advance_positions(position, velocity, config.dt);
+    // Re-stepped islands moved along their chord; they leave at their last substep's
+    // velocity, which the chord's average would turn and slow.
+    for (v, change) in velocity.iter_mut().zip(end_velocity_change.iter_mut()) {
+        *v += std::mem::take(change);
+    }
     clock.advance(config.dt);
 }

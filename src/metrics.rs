@@ -57,6 +57,12 @@ pub struct IterationStats {
     /// The contact Newton's sparse factorizations.
     #[cfg_attr(feature = "serde", serde(default))]
     pub factorizations: u64,
+    /// Solves whose island was stepped again in substeps after one projection failed.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub restepped: u64,
+    /// The substeps those re-stepped solves took, in all.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub substeps: u64,
 }
 
 impl IterationStats {
@@ -67,6 +73,8 @@ impl IterationStats {
         self.max = self.max.max(outcome.iterations);
         self.rejected += u64::from(outcome.rejected);
         self.capped += u64::from(!outcome.converged && !outcome.rejected);
+        self.restepped += u64::from(outcome.restepped);
+        self.substeps += u64::from(outcome.substeps);
     }
 
     /// Add the counts of `other` (solves recorded elsewhere, e.g. on another thread).
@@ -78,6 +86,8 @@ impl IterationStats {
         self.rejected += other.rejected;
         self.newton_solves += other.newton_solves;
         self.factorizations += other.factorizations;
+        self.restepped += other.restepped;
+        self.substeps += other.substeps;
     }
 
     /// Record a joint projection's factorizations (none: its rows were swept).

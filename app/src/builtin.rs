@@ -75,6 +75,21 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         text: include_str!("../../assets/scenes/rope_coil.ron"),
     },
     BuiltinScene {
+        name: "whip",
+        file: "assets/scenes/whip.ron",
+        text: include_str!("../../assets/scenes/whip.ron"),
+    },
+    BuiltinScene {
+        name: "pendulum_1e4",
+        file: "assets/scenes/pendulum_1e4.ron",
+        text: include_str!("../../assets/scenes/pendulum_1e4.ron"),
+    },
+    BuiltinScene {
+        name: "pendulum_1e6",
+        file: "assets/scenes/pendulum_1e6.ron",
+        text: include_str!("../../assets/scenes/pendulum_1e6.ron"),
+    },
+    BuiltinScene {
         name: "sandbox",
         file: "assets/scenes/sandbox.ron",
         text: include_str!("../../assets/scenes/sandbox.ron"),

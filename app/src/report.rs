@@ -112,6 +112,10 @@ pub struct Report {
     pub projection_iterations_max: u32,
     /// Island solves that stopped at the iteration cap.
     pub projection_capped_solves: u64,
+    /// Island solves that one projection could not meet, stepped again in substeps.
+    pub projection_restepped_solves: u64,
+    /// The substeps those re-stepped solves took, in all.
+    pub projection_substeps: u64,
     /// Re-projections of islands in contact (the contact loop): solves, mean and most
     /// iterations, and solves that stopped at the cap.
     pub contact_projection_solves: u64,
@@ -201,10 +205,12 @@ impl Report {
             (
                 "projection_iterations",
                 format!(
-                    "mean {:.2}, max {}, capped {}",
+                    "mean {:.2}, max {}, capped {}, re-stepped {} ({} substeps)",
                     self.projection_iterations_mean,
                     self.projection_iterations_max,
-                    self.projection_capped_solves
+                    self.projection_capped_solves,
+                    self.projection_restepped_solves,
+                    self.projection_substeps
                 ),
             ),
             (

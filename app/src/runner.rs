@@ -521,6 +521,8 @@ fn report(
         projection_iterations_mean: metrics.projection.mean(),
         projection_iterations_max: metrics.projection.max,
         projection_capped_solves: metrics.projection.capped,
+        projection_restepped_solves: metrics.projection.restepped,
+        projection_substeps: metrics.projection.substeps,
         contact_projection_solves: metrics.contact_projection.solves,
         contact_projection_newton_solves: metrics.contact_projection.newton_solves,
         contact_projection_factorizations: metrics.contact_projection.factorizations,

@@ -55,6 +55,7 @@ const PARALLEL_EDGES: usize = 4096;
 #[derive(Debug, Default)]
 struct Lane {
     velocity: Vec<DVec2>,
+    end_change: Vec<DVec2>,
     impulse: Vec<f64>,
     scratch: IslandScratch,
     stats: IterationStats,
@@ -121,6 +122,8 @@ impl Islands {
         for lane in lanes.iter_mut() {
             lane.velocity.clear();
             lane.velocity.extend_from_slice(bodies.velocity);
+            lane.end_change.clear();
+            lane.end_change.resize(bodies.velocity.len(), DVec2::ZERO);
             lane.impulse.clear();
             lane.impulse.resize(impulse.len(), 0.0);
             lane.stats = IterationStats::default();
@@ -129,7 +132,8 @@ impl Islands {
         std::thread::scope(|scope| {
             for lane in lanes.iter_mut() {
                 scope.spawn(move || {
-                    let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass);
+                    let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass)
+                        .with_end_change(&mut lane.end_change);
                     for slot in lane.slots.clone() {
                         let view = IslandView::of(set, solved[slot]);
                         project_met(
@@ -156,6 +160,9 @@ impl Islands {
                 for e in &set.edges[set.islands[solved[slot]].edges.clone()] {
                     for j in [e.a as usize, e.b as usize] {
                         bodies.velocity[j] = lane.velocity[j];
+                        if let Some(end_change) = bodies.end_change.as_deref_mut() {
+                            end_change[j] = lane.end_change[j];
+                        }
                     }
                     impulse[e.edge as usize] += lane.impulse[e.edge as usize];
                 }
@@ -401,9 +408,11 @@ pub fn solve_constraints(
         position,
         velocity,
         inverse_mass,
+        end_velocity_change,
         ..
     } = &mut *state;
-    let mut bodies = Bodies::new(position, velocity, inverse_mass);
+    let mut bodies =
+        Bodies::new(position, velocity, inverse_mass).with_end_change(end_velocity_change);
     let settings = config.projection();
     islands.begin_step();
     match config.solver.relaxation() {

@@ -61,6 +61,7 @@ pub fn relax(
         position,
         velocity,
         inverse_mass: w,
+        ..
     } = bodies;
     scratch.reserve(position.len(), edges.len());
     let s = scratch;
@@ -159,6 +160,7 @@ mod tests {
             tolerance: 1e-12,
             max_iterations: iterations,
             direction: ConstraintDirection::EndOfStep,
+            max_restep_depth: 0,
         }
     }
 

@@ -7,7 +7,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::collision::broad_phase::BroadPhaseMethod;
-use crate::constraints::projection::{ConstraintDirection, ContactSolver, ProjectionSettings};
+use crate::constraints::projection::{
+    ConstraintDirection, ContactSolver, MAX_RESTEP_DEPTH, ProjectionSettings,
+};
 use crate::constraints::solver::SolverKind;
 use crate::model::validate::{
     NumberError, at_least, finite_vector, non_negative, positive, within,
@@ -239,6 +241,10 @@ pub struct ConstraintConfig {
     pub direction: ConstraintDirection,
     /// Keep stretch springs on constrained edges too (constraint-drift studies).
     pub stretch_springs: bool,
+    /// An island whose projection does not converge in `max_iterations` is stepped
+    /// again in substeps, halved where they fail down to `dt / 2^max_restep_depth`
+    /// (at most 30); 0 turns re-stepping off, leaving such a projection capped.
+    pub max_restep_depth: u32,
 }
 
 impl Default for ConstraintConfig {
@@ -249,6 +255,7 @@ impl Default for ConstraintConfig {
             max_iterations: 20,
             direction: ConstraintDirection::EndOfStep,
             stretch_springs: false,
+            max_restep_depth: 12,
         }
     }
 }
@@ -260,13 +267,24 @@ impl ConstraintConfig {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             direction: self.direction,
+            max_restep_depth: self.max_restep_depth,
         }
     }
 
     /// Check every number against its meaning.
     pub fn validate(&self) -> Result<(), NumberError> {
         positive("tolerance", self.tolerance)?;
-        at_least("max_iterations", self.max_iterations as usize, 1, "a solve")
+        at_least("max_iterations", self.max_iterations as usize, 1, "a solve")?;
+        if self.max_restep_depth > MAX_RESTEP_DEPTH {
+            return Err(NumberError {
+                field: "max_restep_depth".into(),
+                problem: format!(
+                    "must be at most {MAX_RESTEP_DEPTH} (substeps of dt / 2^{MAX_RESTEP_DEPTH}), got {}",
+                    self.max_restep_depth
+                ),
+            });
+        }
+        Ok(())
     }
 }
 

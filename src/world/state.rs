@@ -29,6 +29,10 @@ pub struct ParticleState {
     pub inverse_mass: Vec<f64>,
     /// Whether the particle took part in a contact this step.
     pub in_contact: Vec<bool>,
+    /// What the velocity changes by once Integrate has moved the particle: where the
+    /// projection re-stepped its island in substeps, the last substep's velocity less
+    /// the step's chord (the motion the rest of the step sees); otherwise zero.
+    pub end_velocity_change: Vec<DVec2>,
 }
 
 impl ParticleState {
@@ -81,5 +85,6 @@ impl ParticleState {
         self.mass.resize(n, 1.0);
         self.inverse_mass.resize(n, 1.0);
         self.in_contact.resize(n, false);
+        self.end_velocity_change.resize(n, DVec2::ZERO);
     }
 }

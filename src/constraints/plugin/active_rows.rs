@@ -351,6 +351,7 @@ mod tests {
                     tolerance: 1e-13,
                     max_iterations: 30,
                     direction: ConstraintDirection::EndOfStep,
+                    max_restep_depth: 0,
                 },
                 sweeps: 200,
                 contact_tolerance: TOLERANCE,

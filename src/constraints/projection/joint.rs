@@ -67,6 +67,7 @@ pub fn project_jointly(
         position,
         velocity,
         inverse_mass,
+        ..
     } = bodies;
     let members = Members {
         set,
@@ -557,6 +558,7 @@ mod tests {
                 tolerance: 1e-13,
                 max_iterations: 30,
                 direction: ConstraintDirection::EndOfStep,
+                max_restep_depth: 0,
             },
             sweeps: 200,
             contact_tolerance: TOLERANCE,

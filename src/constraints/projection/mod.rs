@@ -43,6 +43,7 @@ mod joint_rows;
 mod joint_split;
 mod joint_state;
 mod newton;
+mod restep;
 mod scratch;
 mod settings;
 mod view;
@@ -54,8 +55,8 @@ pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
 pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
 pub use settings::{
-    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ProjectionOutcome,
-    ProjectionSettings, ROUND_OFF_FLOOR,
+    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, MAX_RESTEP_DEPTH,
+    ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
 };
 pub use view::{Bodies, Chain, Graph, IslandView};
 
@@ -113,6 +114,7 @@ mod tests {
             tolerance: 1e-13,
             max_iterations: 50,
             direction,
+            max_restep_depth: 0,
         }
     }
 

@@ -4,6 +4,7 @@
 
 use bevy::math::DVec2;
 
+use super::restep::restep;
 use super::scratch::IslandScratch;
 use super::settings::{
     ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
@@ -12,6 +13,13 @@ use super::view::Bodies;
 use super::walk::Walk;
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::tridiagonal::SingularPivot;
+
+/// Past the iteration cap a projection goes on while every `STEADY_WINDOW` Newton
+/// steps cut the residual by at least `STEADY_RATE` ...
+const STEADY_WINDOW: u32 = 5;
+const STEADY_RATE: f64 = 0.5;
+/// ... up to this many times the cap.
+const STEADY_EXTENSION: u32 = 8;
 
 /// Project one island (see [`super::project_island`]) walked by `walk`.
 pub(super) fn project_walk<W: Walk>(
@@ -40,6 +48,7 @@ pub(super) fn project_walk<W: Walk>(
         position,
         velocity,
         inverse_mass,
+        end_change,
     } = bodies;
     for j in 0..particles {
         scratch.correction[j] = DVec2::ZERO;
@@ -56,6 +65,13 @@ pub(super) fn project_walk<W: Walk>(
     let locked = scratch.locked[..m].iter().filter(|&&l| l).count() as u32;
     scratch.edge_impulse[..m].fill(0.0);
     let mut outcome = iterate(edges, walk, settings, scratch);
+    if !outcome.converged && settings.max_restep_depth > 0 {
+        // Too far for one projection (a fast turn, a heavy end on a light strand):
+        // the step again in substeps, each projected from the last one's end.
+        let whole = outcome;
+        outcome = restep(edges, walk, position, velocity, dt, settings, scratch);
+        outcome.iterations += whole.iterations;
+    }
     outcome.locked = locked;
     let correction = &scratch.correction[..particles];
     for (j, c) in correction.iter().enumerate() {
@@ -63,12 +79,20 @@ pub(super) fn project_walk<W: Walk>(
             velocity[particle(j)] += *c / dt;
         }
     }
+    if let (true, Some(end_change)) = (outcome.restepped, end_change) {
+        for j in 0..particles {
+            if scratch.inverse_mass[j] > 0.0 {
+                let p = particle(j);
+                end_change[p] = scratch.substep_velocity[j] - velocity[p];
+            }
+        }
+    }
     outcome
 }
 
 /// The Newton iterations from the correction in `scratch` (zero), until the edges meet
 /// the tolerance.
-fn iterate<W: Walk>(
+pub(super) fn iterate<W: Walk>(
     edges: &[IslandEdge],
     walk: W,
     settings: &ProjectionSettings,
@@ -82,6 +106,7 @@ fn iterate<W: Walk>(
         settings.direction
     };
     let mut outcome = ProjectionOutcome::default();
+    let mut checkpoint = f64::INFINITY;
     loop {
         let s = &mut *scratch;
         let mut residual = 0.0f64;
@@ -99,8 +124,18 @@ fn iterate<W: Walk>(
             outcome.converged = true;
             break;
         }
+        // Past the cap, only while the residual still falls steadily: heavy particles
+        // on light ones converge linearly (and not monotonically), but get there.
         if outcome.iterations >= settings.max_iterations {
-            break;
+            let past = outcome.iterations - settings.max_iterations;
+            if past.is_multiple_of(STEADY_WINDOW) {
+                if residual > STEADY_RATE * checkpoint
+                    || outcome.iterations >= settings.max_iterations * STEADY_EXTENSION
+                {
+                    break;
+                }
+                checkpoint = residual;
+            }
         }
         outcome.iterations += 1;
         if newton_step(m, particles, walk, direction, s).is_err() {

@@ -27,6 +27,11 @@ pub struct IslandScratch {
     /// its Newton steps' `−2 λ |d|`.
     pub(super) edge_impulse: Vec<f64>,
     pub(super) factors: Factors,
+    /// Re-stepping (`restep`): each particle's offset from its start of step and its
+    /// velocity in the current substep, and each edge's impulse scaled to the step.
+    pub(super) substep_offset: Vec<DVec2>,
+    pub(super) substep_velocity: Vec<DVec2>,
+    pub(super) substep_impulse: Vec<f64>,
 }
 
 impl IslandScratch {
@@ -50,6 +55,13 @@ impl IslandScratch {
         ] {
             grow(buffer, edges, 0.0);
         }
+    }
+
+    /// Make room for re-stepping an island of `edges` edges among `particles`.
+    pub(super) fn reserve_substeps(&mut self, edges: usize, particles: usize) {
+        grow(&mut self.substep_offset, particles, DVec2::ZERO);
+        grow(&mut self.substep_velocity, particles, DVec2::ZERO);
+        grow(&mut self.substep_impulse, edges, 0.0);
     }
 
     /// The impulse each of the last projected island's `edges` edges carried (mass ×

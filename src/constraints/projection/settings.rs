@@ -77,7 +77,15 @@ pub struct ProjectionSettings {
     pub max_iterations: u32,
     /// Where the constraint direction is evaluated.
     pub direction: ConstraintDirection,
+    /// An island whose projection does not converge is stepped again in substeps,
+    /// halved down to `dt / 2^max_restep_depth` where they fail; 0: never (the
+    /// projection then ends capped).
+    pub max_restep_depth: u32,
 }
+
+/// The deepest re-stepping [`ProjectionSettings::max_restep_depth`] may ask for:
+/// substeps of `dt / 2^30`.
+pub const MAX_RESTEP_DEPTH: u32 = 30;
 
 /// How a projection ended.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -96,6 +104,10 @@ pub struct ProjectionOutcome {
     /// Whether the corrections were too large to be applied (a joint projection's
     /// guard) and were not.
     pub rejected: bool,
+    /// Whether the island was stepped again in substeps after one projection failed.
+    pub restepped: bool,
+    /// The substeps it then took (0 when not re-stepped).
+    pub substeps: u32,
 }
 
 /// The smallest `|C| / L²` asked for whatever the tolerance: edges are formed from

@@ -16,6 +16,10 @@ pub struct Bodies<'a> {
     pub velocity: &'a mut [DVec2],
     /// Inverse masses (0: pinned).
     pub inverse_mass: &'a [f64],
+    /// Where a re-stepped island leaves what its particles' velocities change by once
+    /// the step's positions are taken: its last substep's velocity less the step's
+    /// chord (`None`: the chord is kept).
+    pub end_change: Option<&'a mut [DVec2]>,
 }
 
 impl<'a> Bodies<'a> {
@@ -25,6 +29,15 @@ impl<'a> Bodies<'a> {
             position,
             velocity,
             inverse_mass,
+            end_change: None,
+        }
+    }
+
+    /// The same slices, with `end_change` for re-stepped islands' end velocities.
+    pub fn with_end_change(self, end_change: &'a mut [DVec2]) -> Self {
+        Self {
+            end_change: Some(end_change),
+            ..self
         }
     }
 
@@ -34,6 +47,7 @@ impl<'a> Bodies<'a> {
             position: self.position,
             velocity: &mut *self.velocity,
             inverse_mass: self.inverse_mass,
+            end_change: self.end_change.as_deref_mut(),
         }
     }
 }
