@@ -24,6 +24,9 @@ use super::walk::Walk;
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::tridiagonal::SingularPivot;
 
+/// How many times the iteration cap the finest substeps may take.
+const DEEPEST_BUDGET: u32 = 16;
+
 /// Re-step the island of `edges` over `dt` (its particles at `position` with the
 /// predicted velocities `velocity`, read only). On return `scratch.correction` holds
 /// each particle's correction to `x + dt v*`, as a single projection leaves it, and
@@ -59,7 +62,14 @@ pub(super) fn restep<W: Walk>(
     loop {
         let units = (total >> level).min(total - t);
         let h = dt * units as f64 / total as f64;
-        let attempt = substep(edges, walk, position, h, settings, scratch);
+        // The finest substep gets a longer budget: halving no longer helps there,
+        // and a heavy particle's slow convergence is still convergence.
+        let budget = ProjectionSettings {
+            max_iterations: settings.max_iterations
+                * if level >= depth { DEEPEST_BUDGET } else { 1 },
+            ..*settings
+        };
+        let attempt = substep(edges, walk, position, h, &budget, scratch);
         outcome.iterations += attempt.iterations;
         outcome.residual = attempt.residual;
         outcome.singular |= attempt.singular;
