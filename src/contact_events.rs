@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use crate::colliders::ColliderOf;
 use crate::collision::CollisionScratch;
 use crate::collision::plugin::check_crossings;
+use crate::rollback::RollbackApp;
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet, stepping};
 use crate::world::state::ParticleState;
 use crate::world::strand::StrandOf;
@@ -41,6 +42,10 @@ pub struct ContactEventsPlugin;
 impl Plugin for ContactEventsPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<TouchingPairs>()
+            .roll_back::<TouchingPairs, _>(
+                |pairs| pairs.current.clone(),
+                |pairs, current| pairs.current = current,
+            )
             .add_message::<StrandContact>()
             .add_systems(
                 StrandsStep,

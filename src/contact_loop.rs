@@ -23,6 +23,7 @@ use crate::constraints::projection::{Bodies, ContactRow, JointSettings, RowImpul
 use crate::metrics::StrandMetrics;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
+use crate::rollback::RollbackApp;
 use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
 use crate::speculation::{SpeculationScratch, SpeculationSettings, speculative_rows};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
@@ -37,6 +38,11 @@ impl Plugin for ContactLoopPlugin {
         app.init_resource::<ContactConfig>()
             .init_resource::<ContactRows>()
             .register_type::<ContactConfig>()
+            // The warm starts are the one thing a step leaves for the next.
+            .roll_back::<ContactRows, _>(
+                |rows| (rows.warm.clone(), rows.warm_version),
+                |rows, (warm, version)| (rows.warm, rows.warm_version) = (warm, version),
+            )
             .add_systems(
                 StrandsStep,
                 (

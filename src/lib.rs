@@ -51,6 +51,7 @@ pub mod parallel;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod ribbon;
+pub mod rollback;
 pub mod schedule;
 pub mod snapshot;
 pub mod speculation;

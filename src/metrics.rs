@@ -152,6 +152,10 @@ pub struct StrandMetrics {
     pub collisions_last_step: u64,
     /// Steps that needed the collision fail-safe.
     pub failsafe_steps: u64,
+    /// Steps that would have ended in the fail-safe and were taken again as two halves
+    /// ([`StrandsConfig::max_step_halvings`](crate::world::config::StrandsConfig)).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub halved_steps: u64,
     /// Steps whose collisions still needed impulses after the last re-projection, so
     /// that edges next to those contacts end the step as the impulses left them.
     pub contact_unsettled_steps: u64,

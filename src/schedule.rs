@@ -2,8 +2,10 @@
 //!
 //! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, the
 //! topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
-//! the step schedule, and the write-back. A step ([`StrandsStep`]) runs the stages of
-//! [`StepSet`] in order:
+//! the step schedule, and the write-back. A step that would end in the collision
+//! fail-safe is put back ([`StepRollback`]) and taken as two steps of half its size,
+//! down to `dt / 2^max_step_halvings` ([`StrandsConfig::max_step_halvings`]). A step
+//! ([`StrandsStep`]) runs the stages of [`StepSet`] in order:
 //!
 //! 1. **Forces** — external forces, gravity, damping, springs, bending, tethers.
 //! 2. **Predict** — symplectic Euler predictor `v* = v + dt f / m`.
@@ -43,8 +45,11 @@ use bevy::ecs::schedule::{InternedScheduleLabel, LogLevel, ScheduleBuildSettings
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 
-use crate::world::clock::StepTiming;
+use crate::metrics::StrandMetrics;
+use crate::rollback::{RollbackApp, StepRollback};
+use crate::world::clock::{SimulationClock, StepTiming};
 use crate::world::config::StrandsConfig;
+use crate::world::state::ParticleState;
 
 /// One fixed tick: prepare, gather, `substeps` steps, write back.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -136,6 +141,10 @@ impl Plugin for SchedulePlugin {
         app.add_schedule(step);
         app.init_schedule(StrandsTick);
         app.init_resource::<StepTiming>();
+        // What every step carries forward, for a step taken again in halves.
+        app.roll_back_clone::<ParticleState>()
+            .roll_back_clone::<StrandMetrics>()
+            .roll_back_clone::<SimulationClock>();
 
         app.configure_sets(
             StrandsTick,
@@ -203,17 +212,50 @@ fn run_steps(world: &mut World) {
     if world.get_resource::<SyncOnly>().is_some_and(|s| s.0) {
         return;
     }
-    let substeps = world.resource::<StrandsConfig>().substeps;
+    let config = world.resource::<StrandsConfig>();
+    let (substeps, halvings) = (config.substeps, config.max_step_halvings);
     let start = Instant::now();
     world.schedule_scope(StrandsStep, |world, schedule| {
         for _ in 0..substeps {
-            schedule.run(world);
+            step(world, schedule, halvings);
         }
     });
     let seconds = start.elapsed().as_secs_f64();
     let mut timing = world.resource_mut::<StepTiming>();
     timing.wall_seconds += seconds;
     timing.last_tick_seconds = seconds;
+}
+
+/// Run one step; if it ends in the collision fail-safe and `halvings` allow, put back
+/// what it changed and take it as two steps of half the size instead (each of which
+/// may be halved again).
+fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) {
+    let saved = match (halvings, world.get_resource::<StepRollback>()) {
+        (1.., Some(rollback)) if rollback.allows(world) => Some(rollback.save(world)),
+        _ => None,
+    };
+    let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
+    schedule.run(world);
+    let Some(saved) = saved else {
+        return;
+    };
+    if world.resource::<StrandMetrics>().failsafe_steps == failsafe {
+        return;
+    }
+    saved.restore(world);
+    world.resource_mut::<StrandMetrics>().halved_steps += 1;
+    let dt = world.resource::<StrandsConfig>().dt;
+    world.resource_mut::<StrandsConfig>().dt = 0.5 * dt;
+    // The clock's time is its steps times the step: counted in halves meanwhile, so
+    // that each half ends at its own time, and as one step of `dt` after.
+    let steps = world.resource::<SimulationClock>().steps;
+    world.resource_mut::<SimulationClock>().steps = 2 * steps;
+    step(world, schedule, halvings - 1);
+    step(world, schedule, halvings - 1);
+    world.resource_mut::<StrandsConfig>().dt = dt;
+    let mut clock = world.resource_mut::<SimulationClock>();
+    clock.steps = steps + 1;
+    clock.time = clock.steps as f64 * dt;
 }
 
 /// Run one tick covering the driving schedule's delta (the driver schedule's system);

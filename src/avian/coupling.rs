@@ -52,13 +52,18 @@ struct Coupled {
 }
 
 /// The particles coupled to dynamic bodies this tick, and their impulses.
-#[derive(Resource, Default, Debug)]
+#[derive(Resource, Default, Debug, Clone)]
 pub struct BodyCoupling {
     coupled: Vec<Coupled>,
     velocity_before: Vec<DVec2>,
 }
 
 impl BodyCoupling {
+    /// Whether any simulated particle is coupled to a body this tick.
+    pub fn couples(&self) -> bool {
+        self.coupled.iter().any(|c| c.index != u32::MAX)
+    }
+
     /// The impulse each coupled particle's body received in the last tick, as
     /// (particle, body, impulse), in a fixed order.
     pub fn impulses(&self) -> impl Iterator<Item = (Entity, Entity, DVec2)> + '_ {

@@ -29,6 +29,7 @@ use avian2d::prelude::{
 use crate::colliders::{
     ColliderShape, OutlineBuild, StrandCollider, spawn_anchored_outline, spawn_outline,
 };
+use crate::rollback::{RollbackApp, StepRollback};
 use crate::schedule::{
     CollideSet, ConstrainSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
 };
@@ -74,6 +75,18 @@ impl Default for StrandsAvianPlugin {
 
 impl Plugin for StrandsAvianPlugin {
     fn build(&self, app: &mut App) {
+        // No step that couples a body is taken again in halves: avian moves its bodies
+        // between ticks, so an anchored end starts the tick off its length by what
+        // avian moved it, and half the step corrects that twice as fast (a rope of a
+        // two-thousandth of its crate flew apart).
+        app.init_resource::<StepRollback>();
+        app.world_mut()
+            .resource_mut::<StepRollback>()
+            .forbid_when(|world| {
+                world
+                    .get_resource::<BodyCoupling>()
+                    .is_some_and(BodyCoupling::couples)
+            });
         app.register_type::<CollidesWithStrands>()
             .register_type::<BodyAnchor>()
             .init_resource::<BodyCoupling>()
@@ -98,6 +111,8 @@ impl Plugin for StrandsAvianPlugin {
                     coupling::push_bodies.after(TickSet::Writeback),
                 ),
             )
+            // A step taken again in halves must not count its impulses twice.
+            .roll_back_clone::<BodyCoupling>()
             .add_systems(
                 StrandsStep,
                 (

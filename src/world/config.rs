@@ -68,6 +68,10 @@ pub struct StrandsConfig {
     /// The most edges the world simulates, likewise.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub max_edges: usize,
+    /// A step that would end in the collision fail-safe (impact zones moved rigidly) is
+    /// put back and taken as two steps of half its size, each halved again if it too
+    /// would, down to `dt / 2^max_step_halvings`; 0: never.
+    pub max_step_halvings: u32,
 }
 
 /// How bending forces are computed.
@@ -165,6 +169,7 @@ impl Default for StrandsConfig {
             threads: 0,
             max_particles: DEFAULT_MAX_PARTICLES,
             max_edges: 2 * DEFAULT_MAX_PARTICLES,
+            max_step_halvings: 6,
         }
     }
 }
@@ -206,9 +211,21 @@ impl StrandsConfig {
         at_least("substeps", self.substeps as usize, 1, "a tick")?;
         finite_vector("gravity", self.gravity)?;
         non_negative("damping", self.damping)?;
+        if self.max_step_halvings > MAX_STEP_HALVINGS {
+            return Err(NumberError {
+                field: "max_step_halvings".into(),
+                problem: format!(
+                    "must be at most {MAX_STEP_HALVINGS} (steps of dt / 2^{MAX_STEP_HALVINGS}), got {}",
+                    self.max_step_halvings
+                ),
+            });
+        }
         self.material.validate().map_err(|e| e.within("material"))
     }
 }
+
+/// The most halvings [`StrandsConfig::max_step_halvings`] may ask for.
+pub const MAX_STEP_HALVINGS: u32 = 16;
 
 /// Constraint solver settings.
 ///
