@@ -106,6 +106,8 @@ pub struct Report {
     pub collisions: u64,
     /// Steps that needed the collision fail-safe.
     pub failsafe_steps: u64,
+    /// Steps that would have ended in the fail-safe, taken again as two halves.
+    pub halved_steps: u64,
     /// Mean constraint-solve iterations per island per step.
     pub projection_iterations_mean: f64,
     /// Most constraint-solve iterations of any island in any step.
@@ -202,6 +204,7 @@ impl Report {
             ("contacts", self.contacts.to_string()),
             ("collisions", self.collisions.to_string()),
             ("failsafe_steps", self.failsafe_steps.to_string()),
+            ("halved_steps", self.halved_steps.to_string()),
             (
                 "projection_iterations",
                 format!(

@@ -49,6 +49,8 @@ pub struct RunOptions {
     pub contact_solver: Option<String>,
     /// Projection iteration cap, instead of the scene's.
     pub iterations: Option<u32>,
+    /// Halvings of a step that would end in the fail-safe, instead of the scene's.
+    pub step_halvings: Option<u32>,
     /// Keep stretch springs on constrained edges.
     pub stretch_springs: bool,
     /// Take the constraint direction at the start of the step.
@@ -168,6 +170,9 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
     }
     if let Some(iterations) = options.iterations {
         scenario.constraints.max_iterations = iterations;
+    }
+    if let Some(halvings) = options.step_halvings {
+        scenario.step.max_step_halvings = halvings;
     }
     scenario.constraints.stretch_springs |= options.stretch_springs;
     if options.start_of_step {
@@ -518,6 +523,7 @@ fn report(
         contacts: metrics.contacts,
         collisions: metrics.collisions,
         failsafe_steps: metrics.failsafe_steps,
+        halved_steps: metrics.halved_steps,
         projection_iterations_mean: metrics.projection.mean(),
         projection_iterations_max: metrics.projection.max,
         projection_capped_solves: metrics.projection.capped,

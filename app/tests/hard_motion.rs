@@ -77,3 +77,37 @@ fn a_million_to_one_pendulum_and_a_whip_stay_exact_at_a_game_step() {
         assert_eq!(metrics.edge_crossings, Some(0), "{name}");
     }
 }
+
+#[test]
+fn a_step_that_would_end_in_the_fail_safe_is_taken_again_in_halves() {
+    // `long_strand` at 1/60, one step a tick: its landing ends one step in the
+    // fail-safe unless that step is taken as two of 1/120 (measured: 1 halved step, no
+    // fail-safe step).
+    let run = |halvings: u32| {
+        let scenario = load_scenario(&RunOptions {
+            scenario: "long_strand".into(),
+            dt: Some(1.0 / 60.0),
+            substeps: Some(1),
+            check_crossings: true,
+            ..Default::default()
+        })
+        .unwrap();
+        let mut app = headless_app(&scenario).unwrap();
+        app.world_mut()
+            .resource_mut::<StrandsConfig>()
+            .max_step_halvings = halvings;
+        ticks(&mut app, 180);
+        let clock = *app.world().resource::<SimulationClock>();
+        (app.world().resource::<StrandMetrics>().clone(), clock)
+    };
+    let (without, _) = run(0);
+    assert!(without.failsafe_steps > 0, "{without:?}");
+    assert_eq!(without.halved_steps, 0);
+    let (with, clock) = run(2);
+    assert_eq!(with.failsafe_steps, 0, "{with:?}");
+    assert!(with.halved_steps > 0);
+    assert!(with.max_rel_length_error < 1e-12, "{with:?}");
+    assert_eq!(with.edge_crossings, Some(0));
+    // The halves add up to the steps they replace.
+    assert!((clock.time - 3.0).abs() < 1e-9, "{clock:?}");
+}

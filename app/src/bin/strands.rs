@@ -69,6 +69,10 @@ struct RunArgs {
     /// island per step (default: the scene's, 20).
     #[arg(long, value_name = "N")]
     iterations: Option<u32>,
+    /// A step that would end in the collision fail-safe is taken again as two halves,
+    /// down to dt / 2^N (default: the scene's, 2; 0: never).
+    #[arg(long, value_name = "N")]
+    step_halvings: Option<u32>,
     /// Keep stretch springs on constrained edges too (constraint-drift studies).
     #[arg(long)]
     stretch_springs: bool,
@@ -168,6 +172,7 @@ fn main() -> ExitCode {
                 bending: args.bending,
                 contact_solver: args.contact_solver,
                 iterations: args.iterations,
+                step_halvings: args.step_halvings,
                 stretch_springs: args.stretch_springs,
                 start_of_step: args.start_of_step,
                 check_crossings: !args.no_check,
