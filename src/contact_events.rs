@@ -12,7 +12,7 @@ use crate::collision::CollisionScratch;
 use crate::collision::plugin::check_crossings;
 use crate::rollback::RollbackApp;
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet, stepping};
-use crate::world::state::ParticleState;
+use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::strand::StrandOf;
 use crate::world::topology::Topology;
 
@@ -42,9 +42,16 @@ pub struct ContactEventsPlugin;
 impl Plugin for ContactEventsPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<TouchingPairs>()
-            .roll_back::<TouchingPairs, _>(
-                |pairs| pairs.current.clone(),
-                |pairs, current| pairs.current = current,
+            .roll_back::<TouchingPairs, Vec<(Entity, Entity)>>(
+                |pairs, current| {
+                    // The two lists trade places every tick: room for the longer.
+                    let room = pairs.current.capacity().max(pairs.previous.capacity());
+                    if current.capacity() < room {
+                        current.reserve(room);
+                    }
+                    copy_buffer(current, &pairs.current);
+                },
+                |pairs, current| copy_buffer(&mut pairs.current, current),
             )
             .add_message::<StrandContact>()
             .add_systems(

@@ -27,7 +27,7 @@ use crate::rollback::RollbackApp;
 use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
 use crate::speculation::{SpeculationScratch, SpeculationSettings, speculative_rows};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
-use crate::world::state::ParticleState;
+use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::Topology;
 
 /// The contact loop's settings and buffers.
@@ -39,9 +39,20 @@ impl Plugin for ContactLoopPlugin {
             .init_resource::<ContactRows>()
             .register_type::<ContactConfig>()
             // The warm starts are the one thing a step leaves for the next.
-            .roll_back::<ContactRows, _>(
-                |rows| (rows.warm.clone(), rows.warm_version),
-                |rows, (warm, version)| (rows.warm, rows.warm_version) = (warm, version),
+            .roll_back::<ContactRows, (Vec<(u32, u32, RowImpulse)>, u64)>(
+                |rows, (warm, version)| {
+                    // The warm starts grow with the keys' buffer: so does their copy.
+                    let room = rows.keys.capacity().max(rows.warm.capacity());
+                    if warm.capacity() < room {
+                        warm.reserve(room);
+                    }
+                    copy_buffer(warm, &rows.warm);
+                    *version = rows.warm_version;
+                },
+                |rows, (warm, version)| {
+                    copy_buffer(&mut rows.warm, warm);
+                    rows.warm_version = *version;
+                },
             )
             .add_systems(
                 StrandsStep,

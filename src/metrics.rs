@@ -12,7 +12,7 @@ use crate::constraints::projection::ProjectionOutcome;
 use crate::model::edge::measure_length_errors;
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet, stepping};
 use crate::world::clock::SimulationClock;
-use crate::world::state::ParticleState;
+use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::{Topology, rebuild_topology};
 
 /// The figures of merit: length errors every step, counts after every rebuild, and the
@@ -63,6 +63,18 @@ pub struct IterationStats {
     /// The substeps those re-stepped solves took, in all.
     #[cfg_attr(feature = "serde", serde(default))]
     pub substeps: u64,
+}
+
+impl StrandMetrics {
+    /// Become a copy of `other`, reusing this one's buffer of edge errors.
+    pub fn copy_from(&mut self, other: &StrandMetrics) {
+        let mut errors = std::mem::take(&mut self.relative_length_error);
+        copy_buffer(&mut errors, &other.relative_length_error);
+        *self = StrandMetrics {
+            relative_length_error: errors,
+            ..*other
+        };
+    }
 }
 
 impl IterationStats {

@@ -3,53 +3,85 @@
 //!
 //! Each area registers the state its step systems carry from one step to the next (the
 //! packed particles, the metrics, the clock, the contact warm starts, a body
-//! coupling's impulses); buffers rebuilt every step are not saved.
+//! coupling's impulses), with how to copy it into a buffer kept from step to step and
+//! back: a steady-state step saves without allocating. Buffers rebuilt every step are
+//! not saved.
+
+use std::marker::PhantomData;
 
 use bevy::ecs::component::Mutable;
 use bevy::prelude::*;
 
-type Restore = Box<dyn FnOnce(&mut World) + Send>;
-type Take = Box<dyn Fn(&World) -> Option<Restore> + Send + Sync>;
+/// One registered resource: its saved copy and how to make and restore it.
+trait Entry: Send + Sync {
+    fn save(&mut self, world: &World);
+    fn restore(&self, world: &mut World);
+}
 
-/// The state a step carries forward, as registered by each area's plugin.
+struct Slot<T, S> {
+    saved: S,
+    present: bool,
+    save: fn(&T, &mut S),
+    restore: fn(&mut T, &S),
+    resource: PhantomData<fn() -> T>,
+}
+
+impl<T: Resource<Mutability = Mutable>, S: Send + Sync + 'static> Entry for Slot<T, S> {
+    fn save(&mut self, world: &World) {
+        self.present = world
+            .get_resource::<T>()
+            .map(|r| (self.save)(r, &mut self.saved))
+            .is_some();
+    }
+
+    fn restore(&self, world: &mut World) {
+        if let (true, Some(mut resource)) = (self.present, world.get_resource_mut::<T>()) {
+            (self.restore)(&mut resource, &self.saved);
+        }
+    }
+}
+
+/// The state a step carries forward, as registered by each area's plugin, and its copy
+/// from before the current step.
 #[derive(Resource, Default)]
 pub struct StepRollback {
-    takers: Vec<Take>,
+    entries: Vec<Box<dyn Entry>>,
     vetoes: Vec<fn(&World) -> bool>,
 }
 
 impl std::fmt::Debug for StepRollback {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("StepRollback")
-            .field("registered", &self.takers.len())
+            .field("registered", &self.entries.len())
+            .field("vetoes", &self.vetoes.len())
             .finish()
     }
 }
 
-/// What [`StepRollback::save`] saved: put it back with [`Saved::restore`].
-pub struct Saved(Vec<Restore>);
-
 impl StepRollback {
-    /// Save the part of resource `T` that `take` returns before each step, put back by
-    /// `restore` when the step is taken again.
-    pub fn register<T: Resource<Mutability = Mutable>, S: Send + 'static>(
+    /// Save resource `T` before each step with `save` (into a buffer of type `S` kept
+    /// between steps), put back by `restore` when the step is taken again.
+    pub fn register<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
         &mut self,
-        take: fn(&T) -> S,
-        restore: fn(&mut T, S),
+        save: fn(&T, &mut S),
+        restore: fn(&mut T, &S),
     ) {
-        self.takers.push(Box::new(move |world: &World| {
-            let saved = take(world.get_resource::<T>()?);
-            Some(Box::new(move |world: &mut World| {
-                if let Some(mut resource) = world.get_resource_mut::<T>() {
-                    restore(&mut resource, saved);
-                }
-            }) as Restore)
+        self.entries.push(Box::new(Slot {
+            saved: S::default(),
+            present: false,
+            save,
+            restore,
+            resource: PhantomData,
         }));
     }
 
-    /// Save the whole of resource `T`.
-    pub fn register_clone<T: Resource<Mutability = Mutable> + Clone>(&mut self) {
-        self.register::<T, T>(T::clone, |resource, saved| *resource = saved);
+    /// Save the whole of resource `T` by `clone_from` (which, for a type whose
+    /// `clone_from` reuses its buffers, allocates nothing in a steady state).
+    pub fn register_clone<T: Resource<Mutability = Mutable> + Clone + Default>(&mut self) {
+        self.register::<T, T>(
+            |r, saved| saved.clone_from(r),
+            |r, saved| r.clone_from(saved),
+        );
     }
 
     /// Never take a step again while `veto` says so (state a step cannot put back).
@@ -62,17 +94,17 @@ impl StepRollback {
         !self.vetoes.iter().any(|veto| veto(world))
     }
 
-    /// Save every registered resource of `world`.
-    pub fn save(&self, world: &World) -> Saved {
-        Saved(self.takers.iter().filter_map(|take| take(world)).collect())
+    /// Save every registered resource of `world`, replacing the last save.
+    pub fn save(&mut self, world: &World) {
+        for entry in &mut self.entries {
+            entry.save(world);
+        }
     }
-}
 
-impl Saved {
-    /// Put every saved resource back as it was.
-    pub fn restore(self, world: &mut World) {
-        for restore in self.0 {
-            restore(world);
+    /// Put every resource saved by the last [`StepRollback::save`] back as it was.
+    pub fn restore(&self, world: &mut World) {
+        for entry in &self.entries {
+            entry.restore(world);
         }
     }
 }
@@ -80,29 +112,32 @@ impl Saved {
 /// Registering state with [`StepRollback`] from a plugin.
 pub trait RollbackApp {
     /// See [`StepRollback::register`].
-    fn roll_back<T: Resource<Mutability = Mutable>, S: Send + 'static>(
+    fn roll_back<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
         &mut self,
-        take: fn(&T) -> S,
-        restore: fn(&mut T, S),
+        save: fn(&T, &mut S),
+        restore: fn(&mut T, &S),
     ) -> &mut Self;
     /// See [`StepRollback::register_clone`].
-    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone>(&mut self) -> &mut Self;
+    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone + Default>(&mut self)
+    -> &mut Self;
 }
 
 impl RollbackApp for App {
-    fn roll_back<T: Resource<Mutability = Mutable>, S: Send + 'static>(
+    fn roll_back<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
         &mut self,
-        take: fn(&T) -> S,
-        restore: fn(&mut T, S),
+        save: fn(&T, &mut S),
+        restore: fn(&mut T, &S),
     ) -> &mut Self {
         self.init_resource::<StepRollback>();
         self.world_mut()
             .resource_mut::<StepRollback>()
-            .register(take, restore);
+            .register(save, restore);
         self
     }
 
-    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone>(&mut self) -> &mut Self {
+    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone + Default>(
+        &mut self,
+    ) -> &mut Self {
         self.init_resource::<StepRollback>();
         self.world_mut()
             .resource_mut::<StepRollback>()

@@ -142,9 +142,15 @@ impl Plugin for SchedulePlugin {
         app.init_schedule(StrandsTick);
         app.init_resource::<StepTiming>();
         // What every step carries forward, for a step taken again in halves.
-        app.roll_back_clone::<ParticleState>()
-            .roll_back_clone::<StrandMetrics>()
-            .roll_back_clone::<SimulationClock>();
+        app.roll_back::<ParticleState, ParticleState>(
+            |state, saved| saved.copy_from(state),
+            |state, saved| state.copy_from(saved),
+        )
+        .roll_back::<StrandMetrics, StrandMetrics>(
+            |metrics, saved| saved.copy_from(metrics),
+            |metrics, saved| metrics.copy_from(saved),
+        )
+        .roll_back_clone::<SimulationClock>();
 
         app.configure_sets(
             StrandsTick,
@@ -230,19 +236,18 @@ fn run_steps(world: &mut World) {
 /// what it changed and take it as two steps of half the size instead (each of which
 /// may be halved again).
 fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) {
-    let saved = match (halvings, world.get_resource::<StepRollback>()) {
-        (1.., Some(rollback)) if rollback.allows(world) => Some(rollback.save(world)),
-        _ => None,
-    };
+    let saving = halvings > 0
+        && (world.get_resource::<StepRollback>()).is_some_and(|rollback| rollback.allows(world));
+    if saving {
+        world.resource_scope(|world, mut rollback: Mut<StepRollback>| rollback.save(world));
+    }
     let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
     schedule.run(world);
-    let Some(saved) = saved else {
-        return;
-    };
-    if world.resource::<StrandMetrics>().failsafe_steps == failsafe {
+    if !saving || world.resource::<StrandMetrics>().failsafe_steps == failsafe {
         return;
     }
-    saved.restore(world);
+    // (A halved step's own save replaces this one: it is no longer needed.)
+    world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
     world.resource_mut::<StrandMetrics>().halved_steps += 1;
     let dt = world.resource::<StrandsConfig>().dt;
     world.resource_mut::<StrandsConfig>().dt = 0.5 * dt;

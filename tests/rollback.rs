@@ -35,10 +35,10 @@ fn a_step_put_back_leaves_the_state_as_it_was() {
         world.resource::<StrandMetrics>().clone(),
         *world.resource::<SimulationClock>(),
     );
-    let saved = world.resource::<StepRollback>().save(world);
+    world.resource_scope(|world, mut rollback: Mut<StepRollback>| rollback.save(world));
     world.run_schedule(StrandsStep);
     assert_ne!(world.resource::<ParticleState>().position, before.0);
-    saved.restore(world);
+    world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
     let after = (
         world.resource::<ParticleState>().position.clone(),
         world.resource::<ParticleState>().velocity.clone(),

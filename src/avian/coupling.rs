@@ -26,7 +26,7 @@ use super::truss::{OutlineVertex, Rigged};
 use crate::world::config::{CollisionConfig, StrandsConfig};
 use crate::world::particle::{Kinematic, Position, SolverIndex, Velocity};
 use crate::world::problems::InputProblems;
-use crate::world::state::ParticleState;
+use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::strand::{Strand, StrandOf};
 
 /// One particle coupled to a dynamic body this tick.
@@ -52,13 +52,19 @@ struct Coupled {
 }
 
 /// The particles coupled to dynamic bodies this tick, and their impulses.
-#[derive(Resource, Default, Debug, Clone)]
+#[derive(Resource, Default, Debug)]
 pub struct BodyCoupling {
     coupled: Vec<Coupled>,
     velocity_before: Vec<DVec2>,
 }
 
 impl BodyCoupling {
+    /// Become a copy of `other`, reusing this one's buffers.
+    pub fn copy_from(&mut self, other: &BodyCoupling) {
+        copy_buffer(&mut self.coupled, &other.coupled);
+        copy_buffer(&mut self.velocity_before, &other.velocity_before);
+    }
+
     /// Whether any simulated particle is coupled to a body this tick.
     pub fn couples(&self) -> bool {
         self.coupled.iter().any(|c| c.index != u32::MAX)

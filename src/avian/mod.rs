@@ -112,7 +112,10 @@ impl Plugin for StrandsAvianPlugin {
                 ),
             )
             // A step taken again in halves must not count its impulses twice.
-            .roll_back_clone::<BodyCoupling>()
+            .roll_back::<BodyCoupling, BodyCoupling>(
+                |coupling, saved| saved.copy_from(coupling),
+                |coupling, saved| coupling.copy_from(saved),
+            )
             .add_systems(
                 StrandsStep,
                 (

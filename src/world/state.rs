@@ -75,6 +75,21 @@ impl ParticleState {
             .sum()
     }
 
+    /// Become a copy of `other`, reusing this one's buffers (no allocation once they
+    /// are as long).
+    pub fn copy_from(&mut self, other: &ParticleState) {
+        copy_buffer(&mut self.entity, &other.entity);
+        copy_buffer(&mut self.position, &other.position);
+        copy_buffer(&mut self.velocity, &other.velocity);
+        copy_buffer(&mut self.force, &other.force);
+        copy_buffer(&mut self.external_force, &other.external_force);
+        copy_buffer(&mut self.mass, &other.mass);
+        copy_buffer(&mut self.inverse_mass, &other.inverse_mass);
+        copy_buffer(&mut self.in_contact, &other.in_contact);
+        self.end_velocity_change
+            .clone_from(&other.end_velocity_change);
+    }
+
     pub(crate) fn resize(&mut self, entities: Vec<Entity>) {
         let n = entities.len();
         self.entity = entities;
@@ -87,4 +102,14 @@ impl ParticleState {
         self.in_contact.resize(n, false);
         self.end_velocity_change.resize(n, DVec2::ZERO);
     }
+}
+
+/// Make `copy` hold what `source` holds, keeping at least `source`'s capacity so that a
+/// copy taken every step grows as seldom as its source does.
+pub fn copy_buffer<T: Clone>(copy: &mut Vec<T>, source: &Vec<T>) {
+    copy.clear();
+    if copy.capacity() < source.len() {
+        copy.reserve(source.capacity());
+    }
+    copy.extend_from_slice(source);
 }
