@@ -234,8 +234,9 @@ fn run_steps(world: &mut World) {
 
 /// Run one step; if it ends in the collision fail-safe and `halvings` allow, put back
 /// what it changed and take it as two steps of half the size instead (each of which
-/// may be halved again).
-fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) {
+/// may be halved again). Whether it ended in the fail-safe after all; such a step
+/// counts once in [`StrandMetrics::failsafe_steps`] however it was cut.
+fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
     let saving = halvings > 0
         && (world.get_resource::<StepRollback>()).is_some_and(|rollback| rollback.allows(world));
     if saving {
@@ -243,8 +244,9 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) {
     }
     let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
     schedule.run(world);
-    if !saving || world.resource::<StrandMetrics>().failsafe_steps == failsafe {
-        return;
+    let failed = world.resource::<StrandMetrics>().failsafe_steps != failsafe;
+    if !saving || !failed {
+        return failed;
     }
     // (A halved step's own save replaces this one: it is no longer needed.)
     world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
@@ -255,12 +257,17 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) {
     // that each half ends at its own time, and as one step of `dt` after.
     let steps = world.resource::<SimulationClock>().steps;
     world.resource_mut::<SimulationClock>().steps = 2 * steps;
-    step(world, schedule, halvings - 1);
-    step(world, schedule, halvings - 1);
+    let first = step(world, schedule, halvings - 1);
+    // Where halving the first half all the way did not spare it the fail-safe, halving
+    // is not what this motion needs: the second half is taken whole.
+    let second = step(world, schedule, if first { 0 } else { halvings - 1 });
     world.resource_mut::<StrandsConfig>().dt = dt;
     let mut clock = world.resource_mut::<SimulationClock>();
     clock.steps = steps + 1;
     clock.time = clock.steps as f64 * dt;
+    let failed = first || second;
+    world.resource_mut::<StrandMetrics>().failsafe_steps = failsafe + u64::from(failed);
+    failed
 }
 
 /// Run one tick covering the driving schedule's delta (the driver schedule's system);
