@@ -166,6 +166,7 @@ impl PluginGroup for StrandsPlugin {
                 driver: self.driver,
                 length_unit: self.length_unit,
             })
+            .add(rollback::RollbackPlugin)
             .add(ForcesPlugin)
             .add(IntegratorPlugin)
             .add(MetricsPlugin)

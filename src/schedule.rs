@@ -3,7 +3,7 @@
 //! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, the
 //! topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
 //! the step schedule, and the write-back. A step that would end in the collision
-//! fail-safe is put back ([`StepRollback`]) and taken as two steps of half its size,
+//! fail-safe is put back (`rollback`) and taken as two steps of half its size,
 //! down to `dt / 2^max_step_halvings` ([`StrandsConfig::max_step_halvings`]). A step
 //! ([`StrandsStep`]) runs the stages of [`StepSet`] in order:
 //!
@@ -42,14 +42,10 @@
 //! simulation with `world.run_schedule(StrandsTick)`: no wall clock.
 
 use bevy::ecs::schedule::{InternedScheduleLabel, LogLevel, ScheduleBuildSettings, ScheduleLabel};
-use bevy::platform::time::Instant;
 use bevy::prelude::*;
 
-use crate::metrics::StrandMetrics;
-use crate::rollback::{RollbackApp, StepRollback};
-use crate::world::clock::{SimulationClock, StepTiming};
+use crate::world::clock::StepTiming;
 use crate::world::config::StrandsConfig;
-use crate::world::state::ParticleState;
 
 /// One fixed tick: prepare, gather, `substeps` steps, write back.
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -141,16 +137,6 @@ impl Plugin for SchedulePlugin {
         app.add_schedule(step);
         app.init_schedule(StrandsTick);
         app.init_resource::<StepTiming>();
-        // What every step carries forward, for a step taken again in halves.
-        app.roll_back::<ParticleState, ParticleState>(
-            |state, saved| saved.copy_from(state),
-            |state, saved| state.copy_from(saved),
-        )
-        .roll_back::<StrandMetrics, StrandMetrics>(
-            |metrics, saved| saved.copy_from(metrics),
-            |metrics, saved| metrics.copy_from(saved),
-        )
-        .roll_back_clone::<SimulationClock>();
 
         app.configure_sets(
             StrandsTick,
@@ -194,7 +180,6 @@ impl Plugin for SchedulePlugin {
                 .chain()
                 .in_set(StepSet::Collide),
         );
-        app.add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
 
         if let Some(driver) = self.driver {
             app.add_systems(driver, drive_tick.in_set(StrandsSystems));
@@ -205,69 +190,12 @@ impl Plugin for SchedulePlugin {
 /// While set, a tick only synchronises (topology, gather, write-back) and takes no step:
 /// what a paused simulation runs, so that edits made while paused show at once.
 #[derive(Resource, Default, Clone, Copy, Debug)]
-pub struct SyncOnly(bool);
+pub struct SyncOnly(pub(crate) bool);
 
 /// Run condition: this tick takes steps (it is not a paused tick that only
 /// synchronises).
 pub fn stepping(sync: Option<Res<SyncOnly>>) -> bool {
     !sync.is_some_and(|s| s.0)
-}
-
-/// Run `substeps` steps and account their wall time.
-fn run_steps(world: &mut World) {
-    if world.get_resource::<SyncOnly>().is_some_and(|s| s.0) {
-        return;
-    }
-    let config = world.resource::<StrandsConfig>();
-    let (substeps, halvings) = (config.substeps, config.max_step_halvings);
-    let start = Instant::now();
-    world.schedule_scope(StrandsStep, |world, schedule| {
-        for _ in 0..substeps {
-            step(world, schedule, halvings);
-        }
-    });
-    let seconds = start.elapsed().as_secs_f64();
-    let mut timing = world.resource_mut::<StepTiming>();
-    timing.wall_seconds += seconds;
-    timing.last_tick_seconds = seconds;
-}
-
-/// Run one step; if it ends in the collision fail-safe and `halvings` allow, put back
-/// what it changed and take it as two steps of half the size instead (each of which
-/// may be halved again). Whether it ended in the fail-safe after all; such a step
-/// counts once in [`StrandMetrics::failsafe_steps`] however it was cut.
-fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
-    let saving = halvings > 0
-        && (world.get_resource::<StepRollback>()).is_some_and(|rollback| rollback.allows(world));
-    if saving {
-        world.resource_scope(|world, mut rollback: Mut<StepRollback>| rollback.save(world));
-    }
-    let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
-    schedule.run(world);
-    let failed = world.resource::<StrandMetrics>().failsafe_steps != failsafe;
-    if !saving || !failed {
-        return failed;
-    }
-    // (A halved step's own save replaces this one: it is no longer needed.)
-    world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
-    world.resource_mut::<StrandMetrics>().halved_steps += 1;
-    let dt = world.resource::<StrandsConfig>().dt;
-    world.resource_mut::<StrandsConfig>().dt = 0.5 * dt;
-    // The clock's time is its steps times the step: counted in halves meanwhile, so
-    // that each half ends at its own time, and as one step of `dt` after.
-    let steps = world.resource::<SimulationClock>().steps;
-    world.resource_mut::<SimulationClock>().steps = 2 * steps;
-    let first = step(world, schedule, halvings - 1);
-    // Where halving the first half all the way did not spare it the fail-safe, halving
-    // is not what this motion needs: the second half is taken whole.
-    let second = step(world, schedule, if first { 0 } else { halvings - 1 });
-    world.resource_mut::<StrandsConfig>().dt = dt;
-    let mut clock = world.resource_mut::<SimulationClock>();
-    clock.steps = steps + 1;
-    clock.time = clock.steps as f64 * dt;
-    let failed = first || second;
-    world.resource_mut::<StrandMetrics>().failsafe_steps = failsafe + u64::from(failed);
-    failed
 }
 
 /// Run one tick covering the driving schedule's delta (the driver schedule's system);

@@ -37,6 +37,7 @@ mod contact_line;
 mod contact_newton;
 mod contact_rows;
 mod contact_scratch;
+mod iterate;
 mod joint;
 mod joint_row;
 mod joint_rows;

@@ -15,7 +15,7 @@
 
 use bevy::math::DVec2;
 
-use super::newton::iterate;
+use super::iterate::iterate;
 use super::scratch::IslandScratch;
 use super::settings::{
     ConstraintDirection, MAX_RESTEP_DEPTH, ProjectionOutcome, ProjectionSettings,
