@@ -167,6 +167,7 @@ fn crossing_check(c: &mut Criterion) {
                         at,
                         &mut broad,
                         on_stage_grid.then_some(&mut stage_grid),
+                        None,
                         BroadPhaseMethod::Grid,
                         threads,
                         &mut pairs,

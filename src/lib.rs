@@ -53,6 +53,7 @@ pub mod render;
 pub mod ribbon;
 pub mod rollback;
 pub mod schedule;
+pub mod sleeping;
 pub mod snapshot;
 pub mod speculation;
 pub mod tearing;
@@ -100,10 +101,12 @@ pub mod prelude {
     pub use crate::world::builder::StrandBuilder;
     pub use crate::world::clock::SimulationClock;
     pub use crate::world::config::{
-        BendingModel, CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, StrandsConfig,
+        BendingModel, CollisionConfig, ConstraintConfig, ContactConfig, LengthUnit, SleepConfig,
+        StrandsConfig,
     };
     pub use crate::world::particle::{
-        ExternalForce, Frozen, Kinematic, Mass, Particle, Pinned, Position, Tether, Velocity,
+        ExternalForce, Frozen, Kinematic, Mass, Particle, Pinned, Position, Sleeping, Tether,
+        Velocity,
     };
     pub use crate::world::problems::InputProblems;
     pub use crate::world::state::ParticleState;
@@ -179,6 +182,7 @@ impl PluginGroup for StrandsPlugin {
             .add(contact_events::ContactEventsPlugin)
             .add(winch::WinchPlugin)
             .add(tearing::TearingPlugin)
+            .add(sleeping::SleepPlugin)
     }
 }
 

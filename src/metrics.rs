@@ -183,6 +183,15 @@ pub struct StrandMetrics {
     pub edge_crossings: Option<u64>,
     /// The first step end at which edges crossed, with the edges (checked mode).
     pub first_crossing: Option<CrossingEvent>,
+    /// Particles in sleeping strands at the end of the latest tick.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub asleep_particles: usize,
+    /// Units (strands joined by shared particles) put to sleep, in all.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub sleeps: u64,
+    /// Units woken, in all.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub wakes: u64,
 }
 
 /// A collision nothing could resolve: a point driven into an edge by kinematic

@@ -1,7 +1,7 @@
 //! The order of a step, in one place.
 //!
-//! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, the
-//! topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
+//! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, sleeping
+//! and waking, the topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
 //! the step schedule, and the write-back. A step that would end in the collision
 //! fail-safe is put back (`rollback`) and taken as two steps of half its size,
 //! down to `dt / 2^max_step_halvings` ([`StrandsConfig::max_step_halvings`]). A step
@@ -61,6 +61,9 @@ pub enum TickSet {
     /// Scene logic that spawns, despawns or drives particles (factories, tools); not
     /// run by a tick that only synchronises.
     Prepare,
+    /// Wake sleeping strands that something will reach or that were written to, and put
+    /// to sleep the groups that have rested long enough (the `sleeping` module).
+    Sleep,
     /// Rebuild the topology and derived caches if anything structural changed.
     Topology,
     /// Copy entity state into the packed arrays.
@@ -142,6 +145,7 @@ impl Plugin for SchedulePlugin {
             StrandsTick,
             (
                 TickSet::Prepare,
+                TickSet::Sleep,
                 TickSet::Topology,
                 TickSet::Gather,
                 TickSet::Step,
@@ -150,7 +154,10 @@ impl Plugin for SchedulePlugin {
                 .chain(),
         );
         // Scene logic follows simulated time: a paused tick does not run it.
-        app.configure_sets(StrandsTick, TickSet::Prepare.run_if(stepping));
+        app.configure_sets(
+            StrandsTick,
+            (TickSet::Prepare, TickSet::Sleep).run_if(stepping),
+        );
         app.configure_sets(
             StrandsStep,
             (

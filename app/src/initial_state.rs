@@ -74,6 +74,7 @@ fn first_problem(world: &World, scene: &Scenario) -> Option<(String, String)> {
         &state.position,
         &mut broad,
         None,
+        None,
         config.broad_phase,
         threads,
         &mut Vec::new(),

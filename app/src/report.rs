@@ -108,6 +108,12 @@ pub struct Report {
     pub failsafe_steps: u64,
     /// Steps that would have ended in the fail-safe, taken again as two halves.
     pub halved_steps: u64,
+    /// Particles asleep at the end of the run.
+    pub asleep_particles: usize,
+    /// Strands (units of strands joined by shared particles) put to sleep, in all.
+    pub sleeps: u64,
+    /// Strands woken, in all.
+    pub wakes: u64,
     /// Mean constraint-solve iterations per island per step.
     pub projection_iterations_mean: f64,
     /// Most constraint-solve iterations of any island in any step.
@@ -205,6 +211,13 @@ impl Report {
             ("collisions", self.collisions.to_string()),
             ("failsafe_steps", self.failsafe_steps.to_string()),
             ("halved_steps", self.halved_steps.to_string()),
+            (
+                "asleep",
+                format!(
+                    "{} of {} particles at the end; {} strands put to sleep, {} woken",
+                    self.asleep_particles, self.particles, self.sleeps, self.wakes
+                ),
+            ),
             (
                 "projection_iterations",
                 format!(

@@ -53,6 +53,8 @@ pub struct RunOptions {
     pub step_halvings: Option<u32>,
     /// Keep stretch springs on constrained edges.
     pub stretch_springs: bool,
+    /// Never put strands to sleep.
+    pub no_sleep: bool,
     /// Take the constraint direction at the start of the step.
     pub start_of_step: bool,
     /// Whether to count edge crossings at every step end.
@@ -175,6 +177,9 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
         scenario.step.max_step_halvings = halvings;
     }
     scenario.constraints.stretch_springs |= options.stretch_springs;
+    if options.no_sleep {
+        scenario.step.sleep.enabled = false;
+    }
     if options.start_of_step {
         scenario.constraints.direction = ConstraintDirection::StartOfStep;
     }
@@ -524,6 +529,9 @@ fn report(
         collisions: metrics.collisions,
         failsafe_steps: metrics.failsafe_steps,
         halved_steps: metrics.halved_steps,
+        asleep_particles: metrics.asleep_particles,
+        sleeps: metrics.sleeps,
+        wakes: metrics.wakes,
         projection_iterations_mean: metrics.projection.mean(),
         projection_iterations_max: metrics.projection.max,
         projection_capped_solves: metrics.projection.capped,

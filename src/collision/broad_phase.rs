@@ -62,9 +62,9 @@ const MAX_CELLS_PER_EDGE: i64 = 4096;
 /// Reusable broad-phase buffers.
 #[derive(Clone, Debug, Default)]
 pub struct BroadPhase {
-    edge_boxes: Vec<Aabb>,
+    pub(super) edge_boxes: Vec<Aabb>,
     /// Each edge's cell range, `None` when oversized: computed once per build.
-    edge_cells: Vec<Option<CellRange>>,
+    pub(super) edge_cells: Vec<Option<CellRange>>,
     /// One over the cell's side: cells are found by a product, not a division (four
     /// per box, the build's longest latency).
     inverse_cell: f64,
@@ -95,7 +95,7 @@ struct QueryLane {
 }
 
 /// Cells `x0..=x1` by `y0..=y1`: 32-bit, so a build reads and writes half the bytes.
-type CellRange = (i32, i32, i32, i32);
+pub(super) type CellRange = (i32, i32, i32, i32);
 
 /// Scaled coordinates at or beyond this many cells from the origin are not entered in
 /// the grid (the box is tested against everything): every cell index, and every
@@ -218,7 +218,7 @@ impl BroadPhase {
 
     /// The cells of a box, or `None` when it is better tested against everything than
     /// entered in the grid.
-    fn cells(&self, b: &Aabb) -> Option<CellRange> {
+    pub(super) fn cells(&self, b: &Aabb) -> Option<CellRange> {
         cells_of(b, self.inverse_cell)
     }
 
@@ -420,7 +420,7 @@ impl BroadPhase {
     /// Visit each edge from `first` on whose box overlaps `query` (its cells `cells`)
     /// once, in a fixed order. `stamp` must differ between consecutive queries on
     /// `seen` and be non-zero.
-    fn visit_cells(
+    pub(super) fn visit_cells(
         &self,
         query: &Aabb,
         cells: Option<CellRange>,
@@ -473,7 +473,7 @@ impl BroadPhase {
         &self.edge_boxes
     }
 
-    fn reset_seen(&mut self) {
+    pub(super) fn reset_seen(&mut self) {
         self.seen.clear();
         self.seen.resize(self.edge_boxes.len(), 0);
     }
@@ -521,7 +521,7 @@ impl BroadPhase {
     /// or with one thread; else the first share on this thread into `pairs`, the others
     /// on scoped threads into their lanes, appended to `pairs` in order after. The
     /// shares' results are folded in order with `combine`: nothing depends on `threads`.
-    fn in_shares<R: Send>(
+    pub(super) fn in_shares<R: Send>(
         &mut self,
         n: usize,
         threads: usize,
@@ -563,9 +563,9 @@ impl BroadPhase {
     }
 
     /// The grid queries of the points in `points`, stamped in `seen`.
-    fn query_points(
+    pub(super) fn query_points(
         &self,
-        points: std::ops::Range<usize>,
+        points: impl Iterator<Item = usize>,
         position: &[DVec2],
         displacement: &[DVec2],
         keep: &(impl Fn(u32, u32) -> bool + Sync),

@@ -30,11 +30,17 @@ pub struct Crossings {
 /// finds every pair the check needs and is counted on instead of building `broad`
 /// (the second build was most of the check's cost). Either way the result is the
 /// same: the count is exact and the first pair the smallest.
+///
+/// `moving`, when given, marks the edges that moved this step: pairs of two edges that
+/// did not are left out (they are as they were at the last check; see
+/// `collision::still`).
+#[allow(clippy::too_many_arguments)]
 pub fn count_crossings(
     edges: &[Edge],
     position: &[DVec2],
     broad: &mut BroadPhase,
     reuse: Option<&mut BroadPhase>,
+    moving: Option<&[bool]>,
     method: BroadPhaseMethod,
     threads: usize,
     pairs: &mut Vec<(u32, u32)>,
@@ -59,7 +65,10 @@ pub fn count_crossings(
                 broad
             }
         };
-        let (pairs, first) = grid.count_edge_pairs(threads, crossed);
+        let (pairs, first) = match moving {
+            Some(moving) => grid.count_moving_edge_pairs(threads, moving, crossed),
+            None => grid.count_edge_pairs(threads, crossed),
+        };
         return Crossings { pairs, first };
     }
     broad.build(edges, position, None, 0.0, threads);
@@ -141,6 +150,7 @@ mod tests {
             position,
             &mut own,
             reuse,
+            None,
             method,
             threads,
             &mut Vec::new(),

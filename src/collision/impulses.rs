@@ -14,6 +14,7 @@ use super::broad_phase::{BroadPhase, BroadPhaseMethod};
 use super::ccd::point_edge_time_of_impact;
 use super::failsafe::ImpactZones;
 use super::response::{collision_normal_change, contact_change, repulsion_normal_change};
+use super::still::{StillScratch, merge_by_point};
 use crate::model::geometry::closest_on_segment;
 use crate::model::motion::{displacement, displacements};
 use crate::model::{Edge, NO_ISLAND, PointEdgePair};
@@ -55,6 +56,9 @@ pub struct Contact {
 #[derive(Clone, Debug, Default)]
 pub struct ImpulseScratch {
     broad: BroadPhase,
+    /// Where much of the world stands still: the grid of the moving edges, queried
+    /// with the still points (see `still`).
+    still: StillScratch,
     /// Candidate (point, edge) pairs of the latest broad phase.
     pub pairs: Vec<(u32, u32)>,
     displacement: Vec<DVec2>,
@@ -210,14 +214,50 @@ impl Collider<'_> {
                 && (w[p as usize] > 0.0 || w[e.a as usize] > 0.0 || w[e.b as usize] > 0.0)
                 && !(e.solid && solid.get(p as usize).copied().unwrap_or(false))
         };
-        scratch.broad.point_edge_pairs(
-            self.settings.broad_phase,
+        let still = &mut scratch.still;
+        let grid = self.settings.broad_phase == BroadPhaseMethod::Grid;
+        if !(grid && still.split(edges, w, &scratch.displacement)) {
+            scratch.broad.point_edge_pairs(
+                self.settings.broad_phase,
+                self.settings.threads,
+                self.position,
+                &scratch.displacement,
+                keep,
+                &mut scratch.pairs,
+            );
+            return;
+        }
+        // Moving points against every edge, still points against the moving edges;
+        // merged in point order.
+        scratch.broad.listed_point_edge_pairs(
             self.settings.threads,
+            &still.moving_points,
             self.position,
             &scratch.displacement,
             keep,
             &mut scratch.pairs,
         );
+        still.pairs.clear();
+        still.broad.build(
+            &still.edges,
+            self.position,
+            Some(&scratch.displacement),
+            self.settings.thickness,
+            self.settings.threads,
+        );
+        let index = &still.edge_index;
+        still.broad.listed_point_edge_pairs(
+            self.settings.threads,
+            &still.still_points,
+            self.position,
+            &scratch.displacement,
+            |p, k| keep(p, index[k as usize]),
+            &mut still.pairs,
+        );
+        for pair in &mut still.pairs {
+            pair.1 = index[pair.1 as usize];
+        }
+        merge_by_point(&mut scratch.pairs, &still.pairs, &mut still.merged);
     }
 
     /// The candidate pairs for the current velocities: those of the last search while

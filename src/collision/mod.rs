@@ -26,5 +26,6 @@ pub mod failsafe;
 pub mod impulses;
 pub mod plugin;
 pub mod response;
+pub mod still;
 
 pub use plugin::{CollisionPlugin, CollisionScratch};

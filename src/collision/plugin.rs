@@ -1,10 +1,12 @@
 //! The Collide stage's systems (all but the contact loop) and the crossing check.
 
+use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::broad_phase::BroadPhase;
 use super::crossings::count_crossings;
 use super::impulses::{Collider, CollisionOutcome, ImpulseScratch, ImpulseSettings};
+use super::still::{STILL_SHARE, moving_edges};
 use crate::metrics::{CrossedEdge, CrossingEvent, StrandMetrics, UnresolvedCollision, measure};
 use crate::schedule::{CollideSet, StepSet, StrandsStep};
 use crate::world::clock::SimulationClock;
@@ -23,6 +25,9 @@ pub struct CollisionScratch {
     stale: bool,
     crossing_pairs: Vec<(u32, u32)>,
     crossing_broad: BroadPhase,
+    /// Which particles stood still this step, and which edges moved.
+    crossing_still: Vec<bool>,
+    crossing_moving: Vec<bool>,
 }
 
 /// Proximity and collision impulses, the step's collision figures and the crossing check.
@@ -215,13 +220,27 @@ pub fn check_crossings(
         impulses,
         crossing_pairs,
         crossing_broad,
+        crossing_still,
+        crossing_moving,
         ..
     } = &mut *scratch;
+    // Where much stands still (a sleeping pile), only pairs with a moving edge.
+    crossing_still.clear();
+    crossing_still.extend(
+        (state.inverse_mass.iter().zip(&state.velocity))
+            .map(|(&w, v)| w == 0.0 && *v == DVec2::ZERO),
+    );
+    let still = crossing_still.iter().filter(|&&s| s).count();
+    let moving = (still as f64 >= STILL_SHARE * crossing_still.len() as f64).then(|| {
+        moving_edges(&topology.edges, crossing_still, crossing_moving);
+        &crossing_moving[..]
+    });
     let crossings = count_crossings(
         &topology.edges,
         &state.position,
         crossing_broad,
         Some(impulses.grid_mut()),
+        moving,
         config.broad_phase,
         step.worker_threads(),
         crossing_pairs,

@@ -72,6 +72,58 @@ pub struct StrandsConfig {
     /// put back and taken as two steps of half its size, each halved again if it too
     /// would, down to `dt / 2^max_step_halvings`; 0: never.
     pub max_step_halvings: u32,
+    /// When strands at rest go to sleep, and whether they do.
+    pub sleep: SleepConfig,
+}
+
+/// Sleeping: a group of strands in contact whose every particle has moved slower than
+/// `speed` for `time` seconds goes to sleep — held exactly where it is, at no cost to
+/// a step but being collided against — and each of its strands wakes when something
+/// moving comes within reach of it, when one of its particles is written to, or when
+/// one of its anchors moves (see [`crate::sleeping`]).
+#[derive(Reflect, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
+pub struct SleepConfig {
+    /// Whether strands sleep.
+    pub enabled: bool,
+    /// The speed (world units per second) at rest: a unit whose every particle stays
+    /// within `speed × time` of where its rest began has rested (a mean over the rest,
+    /// so that trembling in a pile does not count as motion), and a particle faster
+    /// than this outside a resting unit wakes what it will come near. 5 cm/s by
+    /// default, Box2D's threshold.
+    pub speed: f64,
+    /// Seconds a group must stay at rest before it sleeps.
+    pub time: f64,
+}
+
+impl Default for SleepConfig {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            speed: 0.05,
+            time: 0.5,
+        }
+    }
+}
+
+impl SleepConfig {
+    /// No sleeping.
+    pub fn never() -> Self {
+        Self {
+            enabled: false,
+            ..Self::default()
+        }
+    }
+
+    /// Check every number against its meaning.
+    pub fn validate(&self) -> Result<(), NumberError> {
+        non_negative("speed", self.speed)?;
+        non_negative("time", self.time)
+    }
 }
 
 /// How bending forces are computed.
@@ -170,6 +222,7 @@ impl Default for StrandsConfig {
             max_particles: DEFAULT_MAX_PARTICLES,
             max_edges: 2 * DEFAULT_MAX_PARTICLES,
             max_step_halvings: 6,
+            sleep: SleepConfig::default(),
         }
     }
 }
@@ -182,6 +235,10 @@ impl StrandsConfig {
         Self {
             gravity: default.gravity * unit,
             material: default.material.with_length_unit(unit),
+            sleep: SleepConfig {
+                speed: default.sleep.speed * unit,
+                ..default.sleep
+            },
             ..default
         }
     }
@@ -220,6 +277,7 @@ impl StrandsConfig {
                 ),
             });
         }
+        self.sleep.validate().map_err(|e| e.within("sleep"))?;
         self.material.validate().map_err(|e| e.within("material"))
     }
 }

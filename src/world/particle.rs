@@ -69,6 +69,18 @@ pub struct Kinematic;
 #[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
 pub struct Frozen;
 
+/// A particle at rest in a sleeping strand: held like a pinned one, with zero velocity,
+/// its position kept exactly, and no cost to a step beyond being collided against. The
+/// sleeping system ([`crate::sleeping`]) adds it to every particle of a group of
+/// strands that has stayed slow for [`SleepConfig::time`](crate::world::config::SleepConfig)
+/// and removes it when something moving comes within reach, when a particle of the
+/// strand is written to, or when one of its anchors moves. Removing it yourself wakes
+/// the particle's strand.
+#[derive(Component, Reflect, Clone, Copy, Debug, Default)]
+#[reflect(Component)]
+#[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
+pub struct Sleeping;
+
 /// A constant force applied to the particle each step, on top of gravity.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 #[reflect(Component)]

@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use crate::model::validate::check_particle;
 use crate::world::hooks::TopologyDirty;
 use crate::world::particle::{
-    ExternalForce, Frozen, Mass, Particle, Pinned, Position, SolverIndex, Velocity,
+    ExternalForce, Frozen, Mass, Particle, Pinned, Position, Sleeping, SolverIndex, Velocity,
 };
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
@@ -26,6 +26,7 @@ type GatherQuery<'w, 's> = Query<
         Option<&'static ExternalForce>,
         Has<Pinned>,
         Has<Frozen>,
+        Has<Sleeping>,
     ),
     With<Particle>,
 >;
@@ -38,7 +39,7 @@ pub fn gather(
     mut problems: ResMut<InputProblems>,
     particles: GatherQuery,
 ) {
-    for (entity, index, position, velocity, mass, external, fixed, frozen) in &particles {
+    for (entity, index, position, velocity, mass, external, fixed, frozen, asleep) in &particles {
         let Some(i) = index.get() else { continue };
         let pinned = topology.pinned[i];
         if let Err(problem) = check_particle(position.0, velocity.0, mass.0, pinned) {
@@ -48,8 +49,9 @@ pub fn gather(
             continue;
         }
         state.position[i] = position.0;
-        // A pinned or frozen particle stays where it is, whatever its velocity says.
-        state.velocity[i] = if fixed || frozen {
+        // A pinned, frozen or sleeping particle stays where it is, whatever its
+        // velocity says.
+        state.velocity[i] = if fixed || frozen || asleep {
             DVec2::ZERO
         } else {
             velocity.0

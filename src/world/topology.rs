@@ -18,7 +18,7 @@ use crate::model::{Bend, Edge, NO_ISLAND, bend_count};
 use crate::world::config::StrandsConfig;
 use crate::world::hooks::{SpawnOrder, TopologyDirty};
 use crate::world::particle::{
-    Frozen, Kinematic, Mass, Particle, Pinned, Position, SolverIndex, Velocity,
+    Frozen, Kinematic, Mass, Particle, Pinned, Position, Sleeping, SolverIndex, Velocity,
 };
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
@@ -97,7 +97,7 @@ pub fn rebuild_topology(world: &mut World) {
     let mut problems = world.remove_resource::<InputProblems>().unwrap_or_default();
 
     // Particles that can be simulated, and whether each has infinite mass (pinned,
-    // kinematic or frozen).
+    // kinematic, frozen or asleep).
     let mut particles = world.query_filtered::<(
         Entity,
         &Position,
@@ -106,10 +106,13 @@ pub fn rebuild_topology(world: &mut World) {
         Has<Pinned>,
         Has<Kinematic>,
         Has<Frozen>,
+        Has<Sleeping>,
     ), With<Particle>>();
     let mut valid: EntityHashMap<bool> = EntityHashMap::default();
-    for (entity, position, velocity, mass, pinned, kinematic, frozen) in particles.iter(world) {
-        let pinned = pinned || kinematic || frozen;
+    for (entity, position, velocity, mass, pinned, kinematic, frozen, sleeping) in
+        particles.iter(world)
+    {
+        let pinned = pinned || kinematic || frozen || sleeping;
         match check_particle(position.0, velocity.0, mass.0, pinned) {
             Err(problem) => problems.report(entity, format!("particle left out: {problem}")),
             Ok(()) => {

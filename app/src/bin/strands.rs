@@ -76,6 +76,10 @@ struct RunArgs {
     /// Keep stretch springs on constrained edges too (constraint-drift studies).
     #[arg(long)]
     stretch_springs: bool,
+    /// Never put strands at rest to sleep (they sleep by default after resting half a
+    /// second below 1 cm/s).
+    #[arg(long)]
+    no_sleep: bool,
     /// Take the constraint direction at the start of the step (torque-free impulses)
     /// instead of at the end (fast projection).
     #[arg(long)]
@@ -174,6 +178,7 @@ fn main() -> ExitCode {
                 iterations: args.iterations,
                 step_halvings: args.step_halvings,
                 stretch_springs: args.stretch_springs,
+                no_sleep: args.no_sleep,
                 start_of_step: args.start_of_step,
                 check_crossings: !args.no_check,
                 no_collisions: args.no_collisions,
