@@ -37,10 +37,10 @@ use crate::world::particle::{
     ExternalForce, Frozen, Kinematic, Mass, Particle, Pinned, Position, Sleeping, SolverIndex,
     Tether, Velocity,
 };
-use crate::world::state::ParticleState;
+use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::Topology;
 use reach::{ReachInput, ReachScratch, find_reached};
-use units::{NO_UNIT, Units, groups_to_sleep, rest};
+use units::{NO_UNIT, Units, groups_to_sleep, on_the_move, rest};
 
 /// Puts resting strands to sleep and wakes them.
 pub struct SleepPlugin;
@@ -77,6 +77,8 @@ pub struct SleepState {
     rested: Vec<f64>,
     /// Where each unit's particles were when its rest began (as `units.members`).
     anchors: Vec<DVec2>,
+    /// How far each unit's particles are from their anchors (at most).
+    strayed: Vec<f64>,
     asleep: Vec<bool>,
     restless: Vec<bool>,
     /// Pairs of units in contact since the last tick began.
@@ -90,6 +92,8 @@ pub struct SleepState {
     woken: Vec<bool>,
     reached: Vec<bool>,
     sleepers: Vec<u32>,
+    target: Vec<bool>,
+    blocked: Vec<bool>,
 }
 
 impl SleepState {
@@ -172,6 +176,8 @@ fn refresh_units(
     }
     sleep.restless.clear();
     sleep.restless.resize(units.len(), false);
+    sleep.strayed.clear();
+    sleep.strayed.resize(units.len(), 0.0);
     sleep.contacts.clear();
     sleep.version = Some(topology.version);
 }
@@ -225,6 +231,7 @@ fn tally(
         tick,
         &mut sleep.anchors,
         &mut sleep.rested,
+        &mut sleep.strayed,
     );
     metrics.asleep_particles = sleep.asleep_particles();
 }
@@ -317,10 +324,13 @@ fn sleep_and_wake(
                 sleep.restless[u as usize] |= tether;
             }
             sleep.displacement[i] = tick * v + if free { fall } else { DVec2::ZERO };
-            // A resting unit trembles, it does not move: only one that strayed from
-            // its anchor at the last tally (or a wall's particle) reaches out.
-            let settled = u != NO_UNIT && sleep.rested[u as usize] > 0.0;
-            sleep.moving[i] = !settled && v.length_squared() > speed * speed;
+            // A resting unit trembles, it does not move: only one on the move (or a
+            // wall's particle) reaches out.
+            let on_move = u == NO_UNIT || {
+                let u = u as usize;
+                on_the_move(sleep.rested[u], sleep.strayed[u], speed)
+            };
+            sleep.moving[i] = on_move && v.length_squared() > speed * speed;
         }
     }
 
@@ -334,10 +344,12 @@ fn sleep_and_wake(
         config.sleep.time,
         &sleep.contacts,
         &mut sleep.sets,
+        &mut sleep.blocked,
         &mut sleep.sleepers,
     );
     sleep.contacts.clear();
-    let mut target = sleep.asleep.clone();
+    let mut target = std::mem::take(&mut sleep.target);
+    copy_buffer(&mut target, &sleep.asleep);
     for &u in &sleep.sleepers {
         target[u as usize] = true;
     }
@@ -357,6 +369,7 @@ fn sleep_and_wake(
         threads: config.worker_threads(),
     };
     find_reached(&input, &mut sleep.reach, &mut sleep.reached);
+    sleep.target = target;
 
     for u in 0..sleep.units.len() {
         if sleep.asleep[u] && (sleep.woken[u] || sleep.reached[u]) {

@@ -90,9 +90,11 @@ impl Units {
 
 /// Each awake unit's rest: `rested[u]` grows by `tick` while every particle of the
 /// unit stays within `drift` of its anchor (where it was when the rest began); a unit
-/// that strays further starts again from zero, anchored where it is now. A drift over
-/// the whole rest, not a speed at one instant: strands held in a pile tremble by a few
+/// that strays further starts again from zero, anchored where it is now. `strayed[u]`
+/// is how far its particles are from their anchors (at most). A drift over the whole
+/// rest, not a speed at one instant: strands held in a pile tremble by a few
 /// centimetres a second about positions that move by less than a millimetre.
+#[allow(clippy::too_many_arguments)]
 pub fn rest(
     units: &Units,
     position: &[DVec2],
@@ -101,29 +103,44 @@ pub fn rest(
     tick: f64,
     anchors: &mut [DVec2],
     rested: &mut [f64],
+    strayed: &mut [f64],
 ) {
     for u in (0..units.len()).filter(|&u| !asleep[u]) {
         let range = units.start[u] as usize..units.start[u + 1] as usize;
         let members = &units.members[range.clone()];
         let anchors = &mut anchors[range];
-        let strayed = members
+        let farthest = members
             .iter()
             .zip(anchors.iter())
-            .any(|(&i, a)| position[i as usize].distance_squared(*a) > drift * drift);
-        if strayed {
+            .map(|(&i, a)| position[i as usize].distance_squared(*a))
+            .fold(0.0, f64::max)
+            .sqrt();
+        if farthest > drift {
             for (&i, a) in members.iter().zip(anchors.iter_mut()) {
                 *a = position[i as usize];
             }
             rested[u] = 0.0;
+            strayed[u] = 0.0;
         } else {
             rested[u] += tick;
+            strayed[u] = farthest;
         }
     }
 }
 
+/// Whether a unit that has rested `rested` seconds and strayed `strayed` from its
+/// anchors is still on the move: its mean speed since its rest began is over `speed`
+/// (or its rest has just begun). A falling strand moves from its first tick; one
+/// trembling in a pile does not.
+pub fn on_the_move(rested: f64, strayed: f64, speed: f64) -> bool {
+    rested == 0.0 || strayed > speed * rested
+}
+
 /// The units to put to sleep now: every unit of a group of awake units joined by
 /// `contacts` (pairs of units) none of which is `restless` and all of which have rested
-/// (`rested[u]` seconds) at least `time`. Appends them to `sleepers` in unit order.
+/// (`rested[u]` seconds) at least `time`. Appends them to `sleepers` in unit order;
+/// `blocked` is scratch.
+#[allow(clippy::too_many_arguments)]
 pub fn groups_to_sleep(
     asleep: &[bool],
     restless: &[bool],
@@ -131,6 +148,7 @@ pub fn groups_to_sleep(
     time: f64,
     contacts: &[(u32, u32)],
     sets: &mut UnionFind,
+    blocked: &mut Vec<bool>,
     sleepers: &mut Vec<u32>,
 ) {
     let n = asleep.len();
@@ -144,7 +162,8 @@ pub fn groups_to_sleep(
     // A group is ready when every member is: one pass marks the roots of the groups
     // with a member that is not.
     let ready = |u: usize| !restless[u] && rested[u] >= time;
-    let mut blocked = vec![false; n];
+    blocked.clear();
+    blocked.resize(n, false);
     for u in (0..n).filter(|&u| !asleep[u] && !ready(u)) {
         let root = sets.find(u);
         blocked[root] = true;
@@ -243,6 +262,7 @@ mod tests {
         let start = [DVec2::ZERO, DVec2::X, DVec2::Y];
         let mut anchors = start.to_vec();
         let mut rested = vec![0.0; 2];
+        let mut strayed = vec![0.0; 2];
         for k in 0..10 {
             // Unit 0 trembles by 1 mm about its start, unit 1 drifts 1 mm a tick.
             let shake = DVec2::new(if k % 2 == 0 { 1e-3 } else { -1e-3 }, 0.0);
@@ -261,5 +281,8 @@ mod tests {
         assert!((rested[0] - 1.0).abs() < 1e-12);
         // Past 5 mm at the sixth tick: anchored again, four ticks since.
         assert!((rested[1] - 0.4).abs() < 1e-12, "{}", rested[1]);
+        // Trembling, it is not on the move; drifting 1 mm a tick (1 cm/s), it is.
+        assert!(!on_the_move(rested[0], strayed[0], 5e-3));
+        assert!(on_the_move(rested[1], strayed[1], 5e-3));
     }
 }
