@@ -1,6 +1,6 @@
 //! Debug drawing with gizmos (feature `render`): edges as lines in their kind's colour
 //! (or coloured by their relative length error), particles as dots, pinned particles
-//! red. It draws into its own gizmo group, [`StrandGizmos`], so the app's global gizmo
+//! red, sleeping strands dimmed. It draws into its own gizmo group, [`StrandGizmos`], so the app's global gizmo
 //! settings stay as they were, and it spawns no camera: the app's 2D camera shows it.
 //!
 //! ```no_run
@@ -21,6 +21,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::metrics::StrandMetrics;
+use crate::sleeping::SleepState;
 use crate::world::state::ParticleState;
 use crate::world::strand::StrandKind;
 use crate::world::topology::Topology;
@@ -35,6 +36,8 @@ pub struct DrawSettings {
     pub particles: bool,
     /// ...unless there are more than this many, when the dots would hide the strands.
     pub max_particle_dots: usize,
+    /// Draw sleeping strands dimmed, in a colour of their own.
+    pub show_sleep: bool,
 }
 
 impl Default for DrawSettings {
@@ -43,6 +46,7 @@ impl Default for DrawSettings {
             color_by_error: false,
             particles: true,
             max_particle_dots: 1500,
+            show_sleep: true,
         }
     }
 }
@@ -72,6 +76,9 @@ impl Plugin for StrandsDebugDrawPlugin {
     }
 }
 
+/// Sleeping strands: a dim slate blue, whatever their kind.
+pub const SLEEP_COLOR: Color = Color::srgb(0.32, 0.38, 0.52);
+
 /// A colour from blue (1e-16) through green and yellow to red (1e-2) for a relative
 /// length error.
 pub fn error_color(error: f64) -> Color {
@@ -98,8 +105,10 @@ pub fn draw_strands(
     topology: Res<Topology>,
     metrics: Res<StrandMetrics>,
     settings: Res<DrawSettings>,
+    sleep: Option<Res<SleepState>>,
     cameras: Query<&Projection, With<Camera2d>>,
 ) {
+    let asleep = |i: u32| settings.show_sleep && sleep.as_ref().is_some_and(|s| s.is_asleep(i as usize));
     if state.len() != topology.pinned.len() {
         return; // the packed state is being rebuilt
     }
@@ -109,7 +118,9 @@ pub fn draw_strands(
             to_vec2(state.position[edge.b as usize]),
         );
         let kind = topology.strands[edge.strand as usize].kind;
-        let color = if settings.color_by_error && kind != StrandKind::Wall {
+        let color = if asleep(edge.a) {
+            SLEEP_COLOR
+        } else if settings.color_by_error && kind != StrandKind::Wall {
             error_color(metrics.relative_length_error.get(k).copied().unwrap_or(0.0))
         } else {
             let [r, g, b] = kind.color();
@@ -128,7 +139,13 @@ pub fn draw_strands(
         1.6 * radius
     };
     for (i, &p) in state.position.iter().enumerate() {
-        if topology.pinned[i] {
+        if asleep(i as u32) {
+            if dots {
+                gizmos
+                    .circle_2d(to_vec2(p), 0.6 * radius, SLEEP_COLOR)
+                    .resolution(6);
+            }
+        } else if topology.pinned[i] {
             gizmos
                 .circle_2d(to_vec2(p), pin_radius, Color::srgb_u8(230, 60, 50))
                 .resolution(10);

@@ -237,6 +237,7 @@ mod tests {
             0.5,
             &contacts,
             &mut sets,
+            &mut Vec::new(),
             &mut sleepers,
         );
         assert_eq!(sleepers, vec![2]);
@@ -249,6 +250,7 @@ mod tests {
             0.5,
             &contacts,
             &mut sets,
+            &mut Vec::new(),
             &mut sleepers,
         );
         assert_eq!(sleepers, vec![0, 1, 2]);
@@ -276,6 +278,7 @@ mod tests {
                 0.1,
                 &mut anchors,
                 &mut rested,
+                &mut strayed,
             );
         }
         assert!((rested[0] - 1.0).abs() < 1e-12);

@@ -256,6 +256,7 @@ fn controls(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands)
         });
         ui.add(egui::Slider::new(&mut step.gravity.y, -30.0..=0.0).text("gravity y"));
         ui.add(egui::Slider::new(&mut step.damping, 0.0..=5.0).text("damping"));
+        ui.checkbox(&mut step.sleep.enabled, "strands at rest sleep");
     });
 }
 
@@ -303,6 +304,10 @@ fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
         );
         row("impulses / step", format!("{}", m.collisions_last_step));
         row("fail-safe steps", format!("{}", m.failsafe_steps));
+        row(
+            "asleep",
+            format!("{} of {} particles", m.asleep_particles, m.particles),
+        );
         row("ms / step", format!("{per_step_ms:.3}"));
         row(
             "real-time factor",
@@ -385,6 +390,7 @@ fn solver_ui(ui: &mut egui::Ui, settings: &mut Settings) {
     });
     edit(&mut settings.draw, |d| {
         ui.checkbox(&mut d.color_by_error, "colour edges by length error");
+        ui.checkbox(&mut d.show_sleep, "dim sleeping strands");
         ui.checkbox(
             &mut d.particles,
             format!("draw particles (up to {})", d.max_particle_dots),
