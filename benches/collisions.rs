@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::broad_phase::{BroadPhase, BroadPhaseMethod};
-use bevy_strands::collision::crossings::count_crossings;
+use bevy_strands::collision::crossings::{Among, count_crossings};
 use bevy_strands::model::Edge;
 use bevy_strands::prelude::*;
 use bevy_strands_app::fixtures::{run_collide_stage, spawn_container};
@@ -167,7 +167,7 @@ fn crossing_check(c: &mut Criterion) {
                         at,
                         &mut broad,
                         on_stage_grid.then_some(&mut stage_grid),
-                        None,
+                        Among::All,
                         BroadPhaseMethod::Grid,
                         threads,
                         &mut pairs,

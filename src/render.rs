@@ -108,7 +108,8 @@ pub fn draw_strands(
     sleep: Option<Res<SleepState>>,
     cameras: Query<&Projection, With<Camera2d>>,
 ) {
-    let asleep = |i: u32| settings.show_sleep && sleep.as_ref().is_some_and(|s| s.is_asleep(i as usize));
+    let asleep =
+        |i: u32| settings.show_sleep && sleep.as_ref().is_some_and(|s| s.is_asleep(i as usize));
     if state.len() != topology.pinned.len() {
         return; // the packed state is being rebuilt
     }

@@ -199,6 +199,11 @@ fn assert_exact_through_contact(app: &App) {
 #[test]
 fn trees_are_solved_by_the_sparse_solve() {
     let mut app = checked_app();
+    // The islands are counted at rest: awake, not asleep (a sleeping strand has none).
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .sleep
+        .enabled = false;
     spawn_box(&mut app);
     let mut rng = StdRng::seed_from_u64(7);
     // A trunk with two branches forking from its middle particle: a tree.
@@ -249,6 +254,11 @@ fn trees_are_solved_by_the_sparse_solve() {
 #[test]
 fn graphs_with_loops_and_a_redundant_brace_are_solved() {
     let mut app = checked_app();
+    // The islands are counted at rest: awake, not asleep (a sleeping strand has none).
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .sleep
+        .enabled = false;
     spawn_box(&mut app);
     let mut rng = StdRng::seed_from_u64(8);
     // A ladder: two rails joined by rungs, a graph of many loops, tumbling down.

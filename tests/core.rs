@@ -72,6 +72,11 @@ fn spring_pair_oscillates_with_the_expected_period() {
     let dt = 1e-4;
     set_step(&mut app, dt, 1);
     app.world_mut().resource_mut::<StrandsConfig>().gravity = DVec2::ZERO;
+    // A millimetre's swing, two seconds long: it would rest, and sleep.
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .sleep
+        .enabled = false;
     app.world_mut().resource_mut::<ConstraintConfig>().solver = SolverKind::Springs;
     let (k, rest, m) = (50.0, 0.1, 0.5);
     let material = StrandMaterial {

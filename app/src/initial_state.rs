@@ -9,7 +9,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::broad_phase::BroadPhase;
 use bevy_strands::collision::clearance::overlaps;
-use bevy_strands::collision::crossings::count_crossings;
+use bevy_strands::collision::crossings::{Among, count_crossings};
 use bevy_strands::prelude::*;
 use bevy_strands::schedule::synchronise;
 
@@ -74,7 +74,7 @@ fn first_problem(world: &World, scene: &Scenario) -> Option<(String, String)> {
         &state.position,
         &mut broad,
         None,
-        None,
+        Among::All,
         config.broad_phase,
         threads,
         &mut Vec::new(),

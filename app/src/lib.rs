@@ -23,3 +23,4 @@ pub mod snapshot;
 pub mod spawn;
 #[cfg(feature = "render")]
 pub mod window;
+pub mod worlds;

@@ -31,16 +31,15 @@ pub struct Crossings {
 /// (the second build was most of the check's cost). Either way the result is the
 /// same: the count is exact and the first pair the smallest.
 ///
-/// `moving`, when given, marks the edges that moved this step: pairs of two edges that
-/// did not are left out (they are as they were at the last check; see
-/// `collision::still`).
+/// `among` picks the pairs counted (every pair, or by which edges moved this step;
+/// see `collision::still`).
 #[allow(clippy::too_many_arguments)]
 pub fn count_crossings(
     edges: &[Edge],
     position: &[DVec2],
     broad: &mut BroadPhase,
     reuse: Option<&mut BroadPhase>,
-    moving: Option<&[bool]>,
+    among: Among,
     method: BroadPhaseMethod,
     threads: usize,
     pairs: &mut Vec<(u32, u32)>,
@@ -65,9 +64,12 @@ pub fn count_crossings(
                 broad
             }
         };
-        let (pairs, first) = match moving {
-            Some(moving) => grid.count_moving_edge_pairs(threads, moving, crossed),
-            None => grid.count_edge_pairs(threads, crossed),
+        let (pairs, first) = match among {
+            Among::All => grid.count_edge_pairs(threads, crossed),
+            Among::Moving(moving) => grid.count_moving_edge_pairs(threads, moving, crossed),
+            Among::Still(moving) => grid.count_edge_pairs(threads, |j, k| {
+                !moving[j as usize] && !moving[k as usize] && crossed(j, k)
+            }),
         };
         return Crossings { pairs, first };
     }
@@ -78,6 +80,17 @@ pub fn count_crossings(
         pairs: pairs.len(),
         first: pairs.iter().min().copied(),
     }
+}
+
+/// Which pairs of edges [`count_crossings`] counts.
+#[derive(Clone, Copy, Debug)]
+pub enum Among<'a> {
+    /// Every pair.
+    All,
+    /// Pairs with at least one edge marked moving.
+    Moving(&'a [bool]),
+    /// Pairs of two edges not marked moving (the grid only).
+    Still(&'a [bool]),
 }
 
 /// Below this many edges the cover test runs on one thread.
@@ -150,7 +163,7 @@ mod tests {
             position,
             &mut own,
             reuse,
-            None,
+            Among::All,
             method,
             threads,
             &mut Vec::new(),

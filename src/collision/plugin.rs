@@ -4,7 +4,8 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::broad_phase::BroadPhase;
-use super::crossings::count_crossings;
+use super::broad_phase::BroadPhaseMethod;
+use super::crossings::{Among, Crossings, count_crossings};
 use super::impulses::{Collider, CollisionOutcome, ImpulseScratch, ImpulseSettings};
 use super::still::{STILL_SHARE, moving_edges};
 use crate::metrics::{CrossedEdge, CrossingEvent, StrandMetrics, UnresolvedCollision, measure};
@@ -28,6 +29,9 @@ pub struct CollisionScratch {
     /// Which particles stood still this step, and which edges moved.
     crossing_still: Vec<bool>,
     crossing_moving: Vec<bool>,
+    /// The crossings among still edges, and what they were counted for: a hash of the
+    /// still particles and their positions (they do not move while it holds).
+    still_crossings: Option<(u64, Crossings)>,
 }
 
 /// Proximity and collision impulses, the step's collision figures and the crossing check.
@@ -222,29 +226,62 @@ pub fn check_crossings(
         crossing_broad,
         crossing_still,
         crossing_moving,
+        still_crossings,
         ..
     } = &mut *scratch;
-    // Where much stands still (a sleeping pile), only pairs with a moving edge.
+    // Where much stands still (a sleeping pile), the pairs with a moving edge are
+    // counted every step and those among still edges only when the still set changes.
     crossing_still.clear();
     crossing_still.extend(
         (state.inverse_mass.iter().zip(&state.velocity))
             .map(|(&w, v)| w == 0.0 && *v == DVec2::ZERO),
     );
     let still = crossing_still.iter().filter(|&&s| s).count();
-    let moving = (still as f64 >= STILL_SHARE * crossing_still.len() as f64).then(|| {
+    let grid = config.broad_phase == BroadPhaseMethod::Grid;
+    let threads = step.worker_threads();
+    let crossings = if grid && still as f64 >= STILL_SHARE * crossing_still.len() as f64 {
         moving_edges(&topology.edges, crossing_still, crossing_moving);
-        &crossing_moving[..]
-    });
-    let crossings = count_crossings(
-        &topology.edges,
-        &state.position,
-        crossing_broad,
-        Some(impulses.grid_mut()),
-        moving,
-        config.broad_phase,
-        step.worker_threads(),
-        crossing_pairs,
-    );
+        let key = still_key(crossing_still, &state.position, topology.version);
+        let mut count = |among| {
+            count_crossings(
+                &topology.edges,
+                &state.position,
+                crossing_broad,
+                Some(impulses.grid_mut()),
+                among,
+                config.broad_phase,
+                threads,
+                crossing_pairs,
+            )
+        };
+        let still = match still_crossings {
+            Some((k, counted)) if *k == key => *counted,
+            _ => {
+                let counted = count(Among::Still(crossing_moving));
+                *still_crossings = Some((key, counted));
+                counted
+            }
+        };
+        let moving = count(Among::Moving(crossing_moving));
+        Crossings {
+            pairs: moving.pairs + still.pairs,
+            first: match (moving.first, still.first) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            },
+        }
+    } else {
+        count_crossings(
+            &topology.edges,
+            &state.position,
+            crossing_broad,
+            Some(impulses.grid_mut()),
+            Among::All,
+            config.broad_phase,
+            threads,
+            crossing_pairs,
+        )
+    };
     metrics.crossing_pairs_last_step = crossings.pairs;
     *metrics.edge_crossings.get_or_insert(0) += u64::from(crossings.pairs > 0);
     if let (Some((j, k)), None) = (crossings.first, &metrics.first_crossing) {
@@ -260,4 +297,22 @@ pub fn check_crossings(
         );
         metrics.first_crossing = Some(event);
     }
+}
+
+/// A hash of which particles stand still and where (FNV-1a over their bits), with the
+/// topology's version: while it holds, the still edges are where they were.
+fn still_key(still: &[bool], position: &[DVec2], version: u64) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325u64 ^ version;
+    let mut mix = |x: u64| {
+        hash ^= x;
+        hash = hash.wrapping_mul(0x0100_0000_01b3);
+    };
+    for (i, (&s, p)) in still.iter().zip(position).enumerate() {
+        if s {
+            mix(i as u64);
+            mix(p.x.to_bits());
+            mix(p.y.to_bits());
+        }
+    }
+    hash
 }

@@ -1,9 +1,9 @@
 //! Sleeping: strands at rest cost nothing until something moving reaches them.
 //!
 //! Every tick ends with a tally: each unit (strands joined by shared particles, or a
-//! loose particle; see [`units`]) whose fastest particle is slower than
-//! [`SleepConfig::speed`](crate::world::config::SleepConfig) adds the tick to its rest
-//! time, any other starts again from zero; the step's contacts join units into groups.
+//! loose particle; see [`units`]) whose every particle is still within
+//! [`SleepConfig::drift`](crate::world::config::SleepConfig) of where its rest began
+//! adds the tick to its rest time, any other starts again from zero; the step's contacts join units into groups.
 //! At the start of the next tick, before the topology rebuild, a group whose every unit
 //! has rested [`SleepConfig::time`](crate::world::config::SleepConfig) goes to sleep:
 //! its particles get the [`Sleeping`] marker, which the topology reads as a pin and the
@@ -222,7 +222,7 @@ fn tally(
         return;
     }
     let tick = config.tick_seconds();
-    let drift = config.sleep.speed * config.sleep.time;
+    let drift = config.sleep.drift;
     rest(
         &sleep.units,
         &state.position,

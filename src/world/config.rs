@@ -76,8 +76,8 @@ pub struct StrandsConfig {
     pub sleep: SleepConfig,
 }
 
-/// Sleeping: a group of strands in contact whose every particle has moved slower than
-/// `speed` for `time` seconds goes to sleep — held exactly where it is, at no cost to
+/// Sleeping: a group of strands in contact whose every particle has stayed within
+/// `drift` of one place for `time` seconds goes to sleep — held exactly where it is, at no cost to
 /// a step but being collided against — and each of its strands wakes when something
 /// moving comes within reach of it, when one of its particles is written to, or when
 /// one of its anchors moves (see [`crate::sleeping`]).
@@ -90,22 +90,27 @@ pub struct StrandsConfig {
 pub struct SleepConfig {
     /// Whether strands sleep.
     pub enabled: bool,
-    /// The speed (world units per second) at rest: a unit whose every particle stays
-    /// within `speed × time` of where its rest began has rested (a mean over the rest,
-    /// so that trembling in a pile does not count as motion), and a particle faster
-    /// than this outside a resting unit wakes what it will come near. 5 cm/s by
-    /// default, Box2D's threshold.
-    pub speed: f64,
-    /// Seconds a group must stay at rest before it sleeps.
+    /// A unit rests while every particle of it stays within `drift` (world units) of
+    /// where its rest began: a bound on where it goes, not on its speed at one
+    /// instant, since strands held in a pile tremble by centimetres a second about
+    /// places they do not leave. 2 cm by default.
+    pub drift: f64,
+    /// Seconds a group must rest before it sleeps: a swing longer than `drift` within
+    /// this time keeps a pendulum awake. 1 s by default.
     pub time: f64,
+    /// The speed (world units per second) of something moving: a particle faster than
+    /// this, of a unit whose mean speed since its rest began is faster too (or of a
+    /// wall), wakes what it will come near. 5 cm/s by default, Box2D's threshold.
+    pub speed: f64,
 }
 
 impl Default for SleepConfig {
     fn default() -> Self {
         Self {
             enabled: true,
+            drift: 0.02,
+            time: 1.0,
             speed: 0.05,
-            time: 0.5,
         }
     }
 }
@@ -121,6 +126,7 @@ impl SleepConfig {
 
     /// Check every number against its meaning.
     pub fn validate(&self) -> Result<(), NumberError> {
+        non_negative("drift", self.drift)?;
         non_negative("speed", self.speed)?;
         non_negative("time", self.time)
     }
@@ -236,6 +242,7 @@ impl StrandsConfig {
             gravity: default.gravity * unit,
             material: default.material.with_length_unit(unit),
             sleep: SleepConfig {
+                drift: default.sleep.drift * unit,
                 speed: default.sleep.speed * unit,
                 ..default.sleep
             },

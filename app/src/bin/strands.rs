@@ -76,8 +76,8 @@ struct RunArgs {
     /// Keep stretch springs on constrained edges too (constraint-drift studies).
     #[arg(long)]
     stretch_springs: bool,
-    /// Never put strands at rest to sleep (they sleep by default after resting half a
-    /// second below 1 cm/s).
+    /// Never put strands at rest to sleep (by default a group that stays within 2 cm
+    /// of one place for a second sleeps).
     #[arg(long)]
     no_sleep: bool,
     /// Take the constraint direction at the start of the step (torque-free impulses)

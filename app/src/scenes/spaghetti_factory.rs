@@ -15,6 +15,7 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::model::geometry::segment_distance;
 use bevy_strands::prelude::*;
+use bevy_strands::sleeping::SleepState;
 use serde::{Deserialize, Serialize};
 
 /// What a spaghetti factory makes: the scenario file's `spaghetti_factory` section.
@@ -120,6 +121,7 @@ pub fn run_spaghetti_factories(
     collisions: Option<Res<CollisionConfig>>,
     state: Res<ParticleState>,
     topology: Res<Topology>,
+    sleep: Option<Res<SleepState>>,
     mut factories: Query<&mut SpaghettiFactory>,
     mut strands: Query<&mut Strand>,
     mut velocities: Query<&mut Velocity>,
@@ -127,7 +129,8 @@ pub fn run_spaghetti_factories(
     let reach = 2.0 * collisions.map_or(0.0, |c| c.thickness);
     let tick = config.tick_seconds();
     for mut factory in &mut factories {
-        let blocked = inlet_blocked(&factory, tick, reach, &state, &topology);
+        let asleep = |i: u32| sleep.as_ref().is_some_and(|s| s.is_asleep(i as usize));
+        let blocked = inlet_blocked(&factory, tick, reach, &state, &topology, asleep);
         if blocked != factory.progress.blocked {
             let velocity = if blocked {
                 DVec2::ZERO
@@ -188,6 +191,7 @@ fn inlet_blocked(
     reach: f64,
     state: &ParticleState,
     topology: &Topology,
+    asleep: impl Fn(u32) -> bool,
 ) -> bool {
     if reach <= 0.0 || factory.finished() {
         return false;
@@ -223,8 +227,9 @@ fn inlet_blocked(
             return true;
         }
         // What the pile brings up into the coming tick's stretch blocks it; walls cannot
-        // move into it, and the tail of the strand just finished moves on ahead.
-        !e.is_static
+        // move into it, and the tail of the strand just finished moves on ahead. A
+        // sleeping strand is held like a wall but is not one: it lies where it lies.
+        !(e.is_static && !asleep(e.a) && !asleep(e.b))
             && Some(e.strand as usize) != own
             && !(keeps_ahead(a) && keeps_ahead(b))
             && segment_distance(from, to, p, q) < reach
