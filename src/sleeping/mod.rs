@@ -324,13 +324,19 @@ fn sleep_and_wake(
                 sleep.restless[u as usize] |= tether;
             }
             sleep.displacement[i] = tick * v + if free { fall } else { DVec2::ZERO };
-            // A resting unit trembles, it does not move: only one on the move (or a
-            // wall's particle) reaches out.
-            let on_move = u == NO_UNIT || {
-                let u = u as usize;
-                on_the_move(sleep.rested[u], sleep.strayed[u], speed)
+            // A driven particle (an anchor, a body's outline) moves at any speed: a
+            // sleeping strand does not answer it, so it must wake first. A free one
+            // moves when faster than the sleep speed and its unit is on the move: a
+            // resting unit trembles, it does not go anywhere.
+            sleep.moving[i] = if kinematic {
+                v != DVec2::ZERO
+            } else {
+                let on_move = u == NO_UNIT || {
+                    let u = u as usize;
+                    on_the_move(sleep.rested[u], sleep.strayed[u], speed)
+                };
+                on_move && v.length_squared() > speed * speed
             };
-            sleep.moving[i] = on_move && v.length_squared() > speed * speed;
         }
     }
 
