@@ -18,7 +18,7 @@ use crate::schedule::synchronise;
 use crate::world::clock::SimulationClock;
 use crate::world::hooks::SpawnOrder;
 use crate::world::particle::{
-    ExternalForce, Kinematic, Mass, Particle, Pinned, Position, Velocity,
+    ExternalForce, Kinematic, Mass, Particle, Pinned, Position, Sleeping, Velocity,
 };
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
 
@@ -47,6 +47,10 @@ pub struct ParticleRecord {
     /// The strand that owns it (index into [`StrandsSnapshot::strands`]).
     #[cfg_attr(feature = "serde", serde(default))]
     pub owner: Option<u32>,
+    /// Whether it sleeps (its strand asleep; see [`crate::sleeping`]). The rest times
+    /// of the strands awake are not kept: they start again from the restore.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub asleep: bool,
 }
 
 /// A strand as captured: its particles by their number in the snapshot.
@@ -181,6 +185,7 @@ impl StrandsSnapshot {
                     pinned: entity.contains::<Pinned>(),
                     kinematic: entity.contains::<Kinematic>(),
                     external_force: entity.get::<ExternalForce>().map(|f| f.0),
+                    asleep: entity.contains::<Sleeping>(),
                     owner: entity
                         .get::<StrandOf>()
                         .and_then(|owner| entities.strand_number(owner.0)),
@@ -282,6 +287,9 @@ impl StrandsSnapshot {
             }
             if let Some(force) = record.external_force {
                 entity.insert(ExternalForce(force));
+            }
+            if record.asleep {
+                entity.insert(Sleeping);
             }
             if let Some(owner) = record.owner {
                 entity.insert(StrandOf(strands[owner as usize]));

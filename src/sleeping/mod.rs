@@ -3,9 +3,10 @@
 //! Every tick ends with a tally: each unit (strands joined by shared particles, or a
 //! loose particle; see [`units`]) whose every particle is still within
 //! [`SleepConfig::drift`](crate::world::config::SleepConfig) of where its rest began
-//! adds the tick to its rest time, any other starts again from zero; the step's contacts join units into groups.
-//! At the start of the next tick, before the topology rebuild, a group whose every unit
-//! has rested [`SleepConfig::time`](crate::world::config::SleepConfig) goes to sleep:
+//! adds the tick to its rest time, any other starts again from zero. At the start of
+//! the next tick, before the topology rebuild, a unit that has rested
+//! [`SleepConfig::time`](crate::world::config::SleepConfig), and whose awake
+//! neighbours in contact (the tick's contacts) have too, goes to sleep:
 //! its particles get the [`Sleeping`] marker, which the topology reads as a pin and the
 //! gather as zero velocity, so a sleeping strand keeps its positions exactly, takes no
 //! part in the projection or the contact solve, and is collided against as a body of
@@ -40,7 +41,7 @@ use crate::world::particle::{
 use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::Topology;
 use reach::{ReachInput, ReachScratch, find_reached};
-use units::{NO_UNIT, Units, groups_to_sleep, on_the_move, rest};
+use units::{NO_UNIT, Units, on_the_move, rest, units_to_sleep};
 
 /// Puts resting strands to sleep and wakes them.
 pub struct SleepPlugin;
@@ -255,7 +256,7 @@ type ParticleQuery<'w, 's> = Query<
 >;
 
 /// The start of a tick: wake what was written to or will be reached, put to sleep the
-/// groups that have rested long enough and that nothing moving will reach.
+/// units that have rested long enough and that nothing moving will reach.
 #[allow(clippy::too_many_arguments)]
 fn sleep_and_wake(
     config: Res<StrandsConfig>,
@@ -340,16 +341,15 @@ fn sleep_and_wake(
         }
     }
 
-    // The groups ready to sleep, then what something moving reaches among them and
+    // The units ready to sleep, then what something moving reaches among them and
     // the sleeping.
     sleep.sleepers.clear();
-    groups_to_sleep(
+    units_to_sleep(
         &sleep.asleep,
         &sleep.restless,
         &sleep.rested,
         config.sleep.time,
         &sleep.contacts,
-        &mut sleep.sets,
         &mut sleep.blocked,
         &mut sleep.sleepers,
     );

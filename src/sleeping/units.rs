@@ -1,11 +1,11 @@
-//! What sleeps and wakes together, and when a group has rested long enough.
+//! What sleeps and wakes together, and when a unit has rested long enough.
 //!
 //! A *unit* is a set of particles that must share one state: the particles of strands
 //! joined by shared particles (a tree, a graph, hairs on one root), or a loose particle
-//! alone. A wall's particles belong to no unit: they never move on their own. Units in
-//! contact form a *group*, which goes to sleep only when every unit in it has rested
-//! for the sleep time, so that nothing still settling is left pushing on a body that no
-//! longer answers. Waking is per unit: a strand something touches wakes, its sleeping
+//! alone. A wall's particles belong to no unit: they never move on their own. A unit
+//! goes to sleep once it has rested for the sleep time and so has every awake unit it
+//! touches, so that nothing still settling is left pushing on a body that no longer
+//! answers. Waking is per unit: a strand something touches wakes, its sleeping
 //! neighbours hold still until something moving reaches them too.
 
 use bevy::math::DVec2;
@@ -136,42 +136,34 @@ pub fn on_the_move(rested: f64, strayed: f64, speed: f64) -> bool {
     rested == 0.0 || strayed > speed * rested
 }
 
-/// The units to put to sleep now: every unit of a group of awake units joined by
-/// `contacts` (pairs of units) none of which is `restless` and all of which have rested
-/// (`rested[u]` seconds) at least `time`. Appends them to `sleepers` in unit order;
-/// `blocked` is scratch.
-#[allow(clippy::too_many_arguments)]
-pub fn groups_to_sleep(
+/// The units to put to sleep now: every awake unit that is not `restless`, has rested
+/// (`rested[u]` seconds) at least `time`, and touches (by `contacts`, pairs of units)
+/// no awake unit that has not. Appends them to `sleepers` in unit order; `blocked` is
+/// scratch. A neighbourhood, not the whole contact group: a pile fed from above
+/// sleeps from the bottom up while strands keep landing on its top, each layer once
+/// the one over it rests too.
+pub fn units_to_sleep(
     asleep: &[bool],
     restless: &[bool],
     rested: &[f64],
     time: f64,
     contacts: &[(u32, u32)],
-    sets: &mut UnionFind,
     blocked: &mut Vec<bool>,
     sleepers: &mut Vec<u32>,
 ) {
     let n = asleep.len();
-    sets.reset(n);
-    for &(a, b) in contacts {
-        let (a, b) = (a as usize, b as usize);
-        if a < n && b < n && !asleep[a] && !asleep[b] {
-            sets.union(a, b);
-        }
-    }
-    // A group is ready when every member is: one pass marks the roots of the groups
-    // with a member that is not.
     let ready = |u: usize| !restless[u] && rested[u] >= time;
     blocked.clear();
     blocked.resize(n, false);
-    for u in (0..n).filter(|&u| !asleep[u] && !ready(u)) {
-        let root = sets.find(u);
-        blocked[root] = true;
-    }
-    for u in (0..n).filter(|&u| !asleep[u] && ready(u)) {
-        if !blocked[sets.find(u)] {
-            sleepers.push(u as u32);
+    for &(a, b) in contacts {
+        let (a, b) = (a as usize, b as usize);
+        if a < n && b < n && !asleep[a] && !asleep[b] {
+            blocked[a] |= !ready(b);
+            blocked[b] |= !ready(a);
         }
+    }
+    for u in (0..n).filter(|&u| !asleep[u] && ready(u) && !blocked[u]) {
+        sleepers.push(u as u32);
     }
 }
 
@@ -222,34 +214,31 @@ mod tests {
     }
 
     #[test]
-    fn a_group_sleeps_only_when_every_member_has_rested() {
+    fn a_unit_sleeps_only_when_its_awake_neighbours_have_rested() {
         // Units 0-1 touch, 2 alone, 3 touches 1 but is asleep, 4 restless.
         let asleep = [false, false, false, true, false];
         let restless = [false, false, false, false, true];
         let rested = [1.0, 0.2, 1.0, 0.0, 1.0];
         let contacts = [(0, 1), (1, 3)];
         let mut sleepers = Vec::new();
-        let mut sets = UnionFind::new(0);
-        groups_to_sleep(
+        units_to_sleep(
             &asleep,
             &restless,
             &rested,
             0.5,
             &contacts,
-            &mut sets,
             &mut Vec::new(),
             &mut sleepers,
         );
         assert_eq!(sleepers, vec![2]);
         let rested = [1.0, 0.6, 1.0, 0.0, 1.0];
         sleepers.clear();
-        groups_to_sleep(
+        units_to_sleep(
             &asleep,
             &restless,
             &rested,
             0.5,
             &contacts,
-            &mut sets,
             &mut Vec::new(),
             &mut sleepers,
         );

@@ -76,8 +76,8 @@ pub struct StrandsConfig {
     pub sleep: SleepConfig,
 }
 
-/// Sleeping: a group of strands in contact whose every particle has stayed within
-/// `drift` of one place for `time` seconds goes to sleep — held exactly where it is, at no cost to
+/// Sleeping: strands whose every particle has stayed within `drift` of one place for
+/// `time` seconds, as have the awake strands they touch, go to sleep — held exactly where it is, at no cost to
 /// a step but being collided against — and each of its strands wakes when something
 /// moving comes within reach of it, when one of its particles is written to, or when
 /// one of its anchors moves (see [`crate::sleeping`]).
@@ -95,7 +95,7 @@ pub struct SleepConfig {
     /// instant, since strands held in a pile tremble by centimetres a second about
     /// places they do not leave. 2 cm by default.
     pub drift: f64,
-    /// Seconds a group must rest before it sleeps: a swing longer than `drift` within
+    /// Seconds a strand must rest before it sleeps: a swing longer than `drift` within
     /// this time keeps a pendulum awake. 1 s by default.
     pub time: f64,
     /// The speed (world units per second) of something moving: a particle faster than
