@@ -16,6 +16,7 @@ use thiserror::Error;
 use tiny_skia::Pixmap;
 
 use bevy_strands::prelude::*;
+use bevy_strands::sleeping::SleepState;
 
 use crate::scenes::Disc;
 use raster::{FrameContent, View, draw_frame};
@@ -204,9 +205,14 @@ impl Recorder {
         ];
         let state = world.resource::<ParticleState>();
         let topology = world.resource::<Topology>();
+        let asleep: Vec<bool> = match world.get_resource::<SleepState>() {
+            Some(sleep) => (0..state.len()).map(|i| sleep.is_asleep(i)).collect(),
+            None => Vec::new(),
+        };
         let content = FrameContent {
             position: &state.position,
             pinned: &topology.pinned,
+            asleep: &asleep,
             edges: &topology.edges,
             strands: &topology.strands,
             discs: &discs,

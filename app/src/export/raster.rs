@@ -36,8 +36,10 @@ impl View {
 pub struct FrameContent<'a> {
     /// Packed positions.
     pub position: &'a [DVec2],
-    /// Which packed particles are pinned.
+    /// Which packed particles are pinned (sleeping ones not: they are drawn dimmed).
     pub pinned: &'a [bool],
+    /// Which packed particles sleep.
+    pub asleep: &'a [bool],
     /// All edges.
     pub edges: &'a [Edge],
     /// All strands (for their kinds).
@@ -52,6 +54,9 @@ pub struct FrameContent<'a> {
 
 /// Background colour.
 pub const BACKGROUND: [u8; 3] = [18, 18, 22];
+
+/// Sleeping strands: a dim slate blue, as in the debug drawing.
+pub const SLEEPING: [u8; 3] = [82, 97, 133];
 
 fn paint(color: [u8; 3]) -> Paint<'static> {
     let mut paint = Paint::default();
@@ -97,6 +102,7 @@ pub fn draw_frame(pixmap: &mut Pixmap, view: &View, content: &FrameContent) {
         }
     }
 
+    let sleeps = |i: u32| content.asleep.get(i as usize).copied().unwrap_or(false);
     let stroke = Stroke {
         width: (2.0 * content.thickness as f32 * scale).clamp(1.0, 4.0),
         line_cap: LineCap::Round,
@@ -112,7 +118,8 @@ pub fn draw_frame(pixmap: &mut Pixmap, view: &View, content: &FrameContent) {
     ] {
         let mut path = PathBuilder::new();
         for strand in content.strands.iter().filter(|s| s.kind == kind) {
-            for edge in &content.edges[strand.edges.clone()] {
+            let edges = content.edges[strand.edges.clone()].iter();
+            for edge in edges.filter(|e| !sleeps(e.a)) {
                 let (ax, ay) = to_pixel(content.position[edge.a as usize]);
                 let (bx, by) = to_pixel(content.position[edge.b as usize]);
                 path.move_to(ax, ay);
@@ -139,17 +146,36 @@ pub fn draw_frame(pixmap: &mut Pixmap, view: &View, content: &FrameContent) {
         }
     }
 
+    // Sleeping strands dimmed, over the rest.
+    let mut sleeping = PathBuilder::new();
+    for edge in content.edges.iter().filter(|e| sleeps(e.a)) {
+        let (ax, ay) = to_pixel(content.position[edge.a as usize]);
+        let (bx, by) = to_pixel(content.position[edge.b as usize]);
+        sleeping.move_to(ax, ay);
+        sleeping.line_to(bx, by);
+    }
+    if let Some(path) = sleeping.finish() {
+        pixmap.stroke_path(
+            &path,
+            &paint(SLEEPING),
+            &stroke,
+            Transform::identity(),
+            None,
+        );
+    }
+
     // Pinned particles in red (the wall corners too); many pins (hair roots) small, so
     // that they mark rather than cover.
     let mut dots = PathBuilder::new();
-    let pins = content.pinned.iter().filter(|&&p| p).count();
+    let pinned = |i: usize| content.pinned.get(i).copied().unwrap_or(false) && !sleeps(i as u32);
+    let pins = (0..content.pinned.len()).filter(|&i| pinned(i)).count();
     let radius = if pins > 100 {
         (0.5 * stroke.width).max(0.75)
     } else {
         (1.5 * stroke.width).max(2.0)
     };
     for (i, &p) in content.position.iter().enumerate() {
-        if content.pinned.get(i).copied().unwrap_or(false) {
+        if pinned(i) {
             let (x, y) = to_pixel(p);
             dots.push_circle(x, y, radius);
         }
