@@ -285,3 +285,46 @@ fn turning_sleeping_off_wakes_everything() {
     assert_eq!(awake.len(), 45);
     assert_eq!(app.world().resource::<StrandMetrics>().asleep_particles, 0);
 }
+
+#[test]
+fn despawning_a_strand_wakes_the_strands_that_rested_on_it() {
+    let mut app = pile(true);
+    until_asleep(&mut app, 600);
+    let (asleep, _) = strands_by_sleep(&mut app);
+    // A strand from the middle of the pile: its lowest particle the median height.
+    let mut by_height: Vec<(f64, Entity)> = asleep
+        .iter()
+        .map(|&s| {
+            let low = strand_segments(&mut app, s)
+                .iter()
+                .map(|&(a, _)| a.y)
+                .fold(f64::INFINITY, f64::min);
+            (low, s)
+        })
+        .collect();
+    by_height.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let gone = by_height[by_height.len() / 2].1;
+    let lay = strand_segments(&mut app, gone);
+    let thickness = app.world().resource::<CollisionConfig>().thickness;
+    let near: HashSet<Entity> = asleep
+        .iter()
+        .copied()
+        .filter(|&s| s != gone)
+        .filter(|&s| {
+            strand_segments(&mut app, s).iter().any(|&(a, b)| {
+                lay.iter()
+                    .any(|&(p, q)| segment_distance(p, q, a, b) <= 2.0 * thickness)
+            })
+        })
+        .collect();
+    assert!(!near.is_empty());
+    app.world_mut().despawn(gone);
+    tick(&mut app);
+    let (_, awake) = strands_by_sleep(&mut app);
+    // Exactly the strands within reach of where it lay.
+    assert_eq!(awake, near);
+    ticks(&mut app, 100);
+    let metrics = app.world().resource::<StrandMetrics>();
+    assert!(metrics.max_rel_length_error < 1e-12);
+    assert_eq!(crossings(&app), 0);
+}

@@ -16,7 +16,8 @@
 //!   body's) will come within two thicknesses of it over the tick ([`reach`]),
 //! - a particle of it is written to (position, velocity, mass, external force) or given
 //!   a tether, or loses its marker, since the last tick, or
-//! - one of its kinematic particles (an anchor) moves.
+//! - one of its kinematic particles (an anchor) moves, or
+//! - a particle within reach of it is despawned (what it rested on is gone).
 //!
 //! Waking is per unit: a strand something touches wakes alone, and its sleeping
 //! neighbours hold still until something moving reaches them in turn.
@@ -266,6 +267,7 @@ fn sleep_and_wake(
     mut sleep: ResMut<SleepState>,
     mut metrics: ResMut<StrandMetrics>,
     particles: ParticleQuery,
+    mut removed: RemovedComponents<Particle>,
     ticks: SystemChangeTick,
     mut commands: Commands,
 ) {
@@ -338,6 +340,14 @@ fn sleep_and_wake(
                 };
                 on_move && v.length_squared() > speed * speed
             };
+        }
+    }
+
+    // A despawned particle lets go of what rested on it: where it lay counts as moving
+    // this tick (its slot still holds its last position until the rebuild).
+    for entity in removed.read() {
+        if let Some(&i) = topology.index.get(&entity).filter(|&&i| (i as usize) < n) {
+            sleep.moving[i as usize] = true;
         }
     }
 

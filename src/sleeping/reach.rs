@@ -75,6 +75,11 @@ pub fn find_reached(input: &ReachInput, scratch: &mut ReachScratch, reached: &mu
             scratch.target_edges.push(*e);
             scratch.linked[e.a as usize] = true;
             scratch.linked[e.b as usize] = true;
+            // A target's edge can move only as a despawned strand's "moves": where it
+            // lay lets go of what rested on it.
+            if moves(e.a) || moves(e.b) {
+                scratch.moving_edges.push(*e);
+            }
         } else if moves(e.a) || moves(e.b) {
             scratch.moving_edges.push(*e);
         }
@@ -196,6 +201,10 @@ fn point_edge(i: u32) -> Edge {
 /// 0 inside either of its two triangles, else the distance to its nearest side.
 pub fn quad_distance(p: DVec2, q: [DVec2; 4]) -> f64 {
     let inside = |a: DVec2, b: DVec2, c: DVec2| {
+        // A flat triangle has no inside (its sides are measured below).
+        if (b - a).perp_dot(c - a) == 0.0 {
+            return false;
+        }
         let (d1, d2, d3) = (
             (b - a).perp_dot(p - a),
             (c - b).perp_dot(p - b),
@@ -244,7 +253,7 @@ mod tests {
         let moving_edges = input
             .edges
             .iter()
-            .filter(|e| !target(e.a) && (input.moving[e.a as usize] || input.moving[e.b as usize]));
+            .filter(|e| input.moving[e.a as usize] || input.moving[e.b as usize]);
         for e in moving_edges {
             let (a, b) = (e.a as usize, e.b as usize);
             for p in (0..x.len() as u32).filter(|&p| target(p)) {
@@ -316,6 +325,10 @@ mod tests {
             DVec2::new(0.0, -1.0),
         ];
         assert_eq!(quad_distance(DVec2::new(0.5, -0.5), quad), 0.0);
+        // A sweep along its own line is flat: a point on that line but past its end is
+        // as far as it is.
+        let flat = [DVec2::ZERO, DVec2::X, DVec2::X, DVec2::ZERO];
+        assert_eq!(quad_distance(DVec2::new(3.0, 0.0), flat), 2.0);
         assert!((quad_distance(DVec2::new(1.5, -0.5), quad) - 0.5).abs() < 1e-15);
     }
 }
