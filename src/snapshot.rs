@@ -47,7 +47,7 @@ pub struct ParticleRecord {
     /// The strand that owns it (index into [`StrandsSnapshot::strands`]).
     #[cfg_attr(feature = "serde", serde(default))]
     pub owner: Option<u32>,
-    /// Whether it sleeps (its strand asleep; see [`crate::sleeping`]). The rest times
+    /// Whether it sleeps (its strand asleep; see the `sleeping` module). The rest times
     /// of the strands awake are not kept: they start again from the restore.
     #[cfg_attr(feature = "serde", serde(default))]
     pub asleep: bool,

@@ -62,9 +62,9 @@ const MAX_CELLS_PER_EDGE: i64 = 4096;
 /// Reusable broad-phase buffers.
 #[derive(Clone, Debug, Default)]
 pub struct BroadPhase {
-    pub(super) edge_boxes: Vec<Aabb>,
+    edge_boxes: Vec<Aabb>,
     /// Each edge's cell range, `None` when oversized: computed once per build.
-    pub(super) edge_cells: Vec<Option<CellRange>>,
+    edge_cells: Vec<Option<CellRange>>,
     /// One over the cell's side: cells are found by a product, not a division (four
     /// per box, the build's longest latency).
     inverse_cell: f64,
@@ -95,7 +95,7 @@ struct QueryLane {
 }
 
 /// Cells `x0..=x1` by `y0..=y1`: 32-bit, so a build reads and writes half the bytes.
-pub(super) type CellRange = (i32, i32, i32, i32);
+type CellRange = (i32, i32, i32, i32);
 
 /// Scaled coordinates at or beyond this many cells from the origin are not entered in
 /// the grid (the box is tested against everything): every cell index, and every
@@ -218,7 +218,7 @@ impl BroadPhase {
 
     /// The cells of a box, or `None` when it is better tested against everything than
     /// entered in the grid.
-    pub(super) fn cells(&self, b: &Aabb) -> Option<CellRange> {
+    fn cells(&self, b: &Aabb) -> Option<CellRange> {
         cells_of(b, self.inverse_cell)
     }
 
@@ -420,7 +420,7 @@ impl BroadPhase {
     /// Visit each edge from `first` on whose box overlaps `query` (its cells `cells`)
     /// once, in a fixed order. `stamp` must differ between consecutive queries on
     /// `seen` and be non-zero.
-    pub(super) fn visit_cells(
+    fn visit_cells(
         &self,
         query: &Aabb,
         cells: Option<CellRange>,
@@ -473,7 +473,7 @@ impl BroadPhase {
         &self.edge_boxes
     }
 
-    pub(super) fn reset_seen(&mut self) {
+    fn reset_seen(&mut self) {
         self.seen.clear();
         self.seen.resize(self.edge_boxes.len(), 0);
     }
@@ -492,7 +492,6 @@ impl BroadPhase {
         keep: impl Fn(u32, u32) -> bool + Sync,
         pairs: &mut Vec<(u32, u32)>,
     ) {
-        self.reset_seen();
         let n = position.len();
         if method == BroadPhaseMethod::BruteForce {
             for i in 0..n {
@@ -505,11 +504,29 @@ impl BroadPhase {
             }
             return;
         }
+        self.query_shares(threads, n, |i| i, position, displacement, keep, pairs);
+    }
+
+    /// The grid queries of `n` points, the `k`th being point `point(k)` (ascending), in
+    /// shares on `threads` threads, appended to `pairs` in order.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn query_shares(
+        &mut self,
+        threads: usize,
+        n: usize,
+        point: impl Fn(usize) -> usize + Sync,
+        position: &[DVec2],
+        displacement: &[DVec2],
+        keep: impl Fn(u32, u32) -> bool + Sync,
+        pairs: &mut Vec<(u32, u32)>,
+    ) {
+        self.reset_seen();
         self.in_shares(
             n,
             threads,
             pairs,
-            |this, points, seen, pairs| {
+            |this, shares, seen, pairs| {
+                let points = shares.map(&point);
                 this.query_points(points, position, displacement, &keep, seen, pairs)
             },
             |(), ()| (),
@@ -521,7 +538,7 @@ impl BroadPhase {
     /// or with one thread; else the first share on this thread into `pairs`, the others
     /// on scoped threads into their lanes, appended to `pairs` in order after. The
     /// shares' results are folded in order with `combine`: nothing depends on `threads`.
-    pub(super) fn in_shares<R: Send>(
+    fn in_shares<R: Send>(
         &mut self,
         n: usize,
         threads: usize,
@@ -563,7 +580,7 @@ impl BroadPhase {
     }
 
     /// The grid queries of the points in `points`, stamped in `seen`.
-    pub(super) fn query_points(
+    fn query_points(
         &self,
         points: impl Iterator<Item = usize>,
         position: &[DVec2],
@@ -584,7 +601,8 @@ impl BroadPhase {
         }
     }
 
-    /// Over every pair of edges (j < k) whose boxes overlap, how many `test` holds for,
+    /// Over every pair of edges (j < k) whose boxes overlap — with `moving`, every such
+    /// pair with at least one moving edge, queried from it — how many `test` holds for,
     /// and the smallest such (j, k): a pair that does not depend on the grid. With
     /// `threads` above one and enough edges, contiguous ranges of j are tested on that
     /// many threads: the same count and the same first pair whatever the count. Call
@@ -592,6 +610,7 @@ impl BroadPhase {
     pub fn count_edge_pairs(
         &mut self,
         threads: usize,
+        moving: Option<&[bool]>,
         test: impl Fn(u32, u32) -> bool + Sync,
     ) -> (usize, Option<(u32, u32)>) {
         self.reset_seen();
@@ -602,8 +621,14 @@ impl BroadPhase {
             n,
             threads,
             &mut none,
-            |this, range, seen, _| this.count_edges(range, &test, seen),
-            |(count, found), (c, f)| (count + c, found.or(f)),
+            |this, range, seen, _| this.count_edges(range, moving, &test, seen),
+            |(count, found), (c, f)| {
+                let first = match (found, f) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    (a, b) => a.or(b),
+                };
+                (count + c, first)
+            },
         )
     }
 
@@ -611,18 +636,24 @@ impl BroadPhase {
     fn count_edges(
         &self,
         range: std::ops::Range<usize>,
+        moving: Option<&[bool]>,
         test: &(impl Fn(u32, u32) -> bool + Sync),
         seen: &mut [u32],
     ) -> (usize, Option<(u32, u32)>) {
         let (mut count, mut first) = (0, None);
-        for j in range {
-            let j = j as u32;
+        let moves = |e: u32| moving.is_none_or(|m| m[e as usize]);
+        for j in range.map(|j| j as u32).filter(|&j| moves(j)) {
             let query = self.edge_boxes[j as usize];
             let cells = self.edge_cells[j as usize];
-            self.visit_cells(&query, cells, (seen, j + 1), j + 1, |k| {
-                if test(j, k) {
+            // All pairs: from the lower edge. Moving pairs: from a moving edge, a pair
+            // of two from the lower.
+            let from = if moving.is_some() { 0 } else { j + 1 };
+            self.visit_cells(&query, cells, (seen, j + 1), from, |k| {
+                let counted = k != j && (!moves(k) || j < k);
+                if counted && test(j, k) {
                     count += 1;
-                    first = Some(first.map_or((j, k), |f: (u32, u32)| f.min((j, k))));
+                    let pair = (j.min(k), j.max(k));
+                    first = Some(first.map_or(pair, |f: (u32, u32)| f.min(pair)));
                 }
             });
         }
@@ -767,11 +798,11 @@ mod tests {
         let test = |j: u32, k: u32| (j + k).is_multiple_of(3);
         let mut listed = Vec::new();
         broad.edge_edge_pairs(BroadPhaseMethod::Grid, test, &mut listed);
-        let one = broad.count_edge_pairs(1, test);
+        let one = broad.count_edge_pairs(1, None, test);
         assert!(one.0 > 1000, "{one:?}");
         assert_eq!(one, (listed.len(), listed.iter().min().copied()));
-        assert_eq!(broad.count_edge_pairs(2, test), one);
-        assert_eq!(broad.count_edge_pairs(3, test), one);
+        assert_eq!(broad.count_edge_pairs(2, None, test), one);
+        assert_eq!(broad.count_edge_pairs(3, None, test), one);
     }
 
     #[test]

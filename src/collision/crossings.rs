@@ -65,9 +65,9 @@ pub fn count_crossings(
             }
         };
         let (pairs, first) = match among {
-            Among::All => grid.count_edge_pairs(threads, crossed),
-            Among::Moving(moving) => grid.count_moving_edge_pairs(threads, moving, crossed),
-            Among::Still(moving) => grid.count_edge_pairs(threads, |j, k| {
+            Among::All => grid.count_edge_pairs(threads, None, crossed),
+            Among::Moving(moving) => grid.count_edge_pairs(threads, Some(moving), crossed),
+            Among::Still(moving) => grid.count_edge_pairs(threads, None, |j, k| {
                 !moving[j as usize] && !moving[k as usize] && crossed(j, k)
             }),
         };

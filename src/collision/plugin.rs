@@ -7,7 +7,7 @@ use super::broad_phase::BroadPhase;
 use super::broad_phase::BroadPhaseMethod;
 use super::crossings::{Among, Crossings, count_crossings};
 use super::impulses::{Collider, CollisionOutcome, ImpulseScratch, ImpulseSettings};
-use super::still::{STILL_SHARE, moving_edges};
+use super::still::{is_still, mostly_still, moving_edges};
 use crate::metrics::{CrossedEdge, CrossingEvent, StrandMetrics, UnresolvedCollision, measure};
 use crate::schedule::{CollideSet, StepSet, StrandsStep};
 use crate::world::clock::SimulationClock;
@@ -231,15 +231,14 @@ pub fn check_crossings(
     } = &mut *scratch;
     // Where much stands still (a sleeping pile), the pairs with a moving edge are
     // counted every step and those among still edges only when the still set changes.
+    // (A particle with no velocity after the step had no displacement over it.)
     crossing_still.clear();
-    crossing_still.extend(
-        (state.inverse_mass.iter().zip(&state.velocity))
-            .map(|(&w, v)| w == 0.0 && *v == DVec2::ZERO),
-    );
+    crossing_still
+        .extend((0..state.len()).map(|i| is_still(&state.inverse_mass, &state.velocity, i)));
     let still = crossing_still.iter().filter(|&&s| s).count();
     let grid = config.broad_phase == BroadPhaseMethod::Grid;
     let threads = step.worker_threads();
-    let crossings = if grid && still as f64 >= STILL_SHARE * crossing_still.len() as f64 {
+    let crossings = if grid && mostly_still(still, crossing_still.len()) {
         moving_edges(&topology.edges, crossing_still, crossing_moving);
         let key = still_key(crossing_still, &state.position, topology.version);
         let mut count = |among| {

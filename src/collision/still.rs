@@ -9,7 +9,7 @@
 
 use bevy::math::DVec2;
 
-use super::broad_phase::{Aabb, BroadPhase};
+use super::broad_phase::BroadPhase;
 use crate::model::Edge;
 
 /// Whether particle `i` stands still this step: pinned (or asleep) and not moving.
@@ -21,6 +21,11 @@ pub fn is_still(inverse_mass: &[f64], displacement: &[DVec2], i: usize) -> bool 
 /// stands still (below it, the usual all-points query is as fast and keeps the
 /// pairs' order as it always was).
 pub const STILL_SHARE: f64 = 0.25;
+
+/// Whether `still` of `n` particles are enough to query from the moving side.
+pub fn mostly_still(still: usize, n: usize) -> bool {
+    n > 0 && still as f64 >= STILL_SHARE * n as f64
+}
 
 impl BroadPhase {
     /// As [`BroadPhase::point_edge_pairs`] with the grid method, for the listed points
@@ -34,60 +39,9 @@ impl BroadPhase {
         keep: impl Fn(u32, u32) -> bool + Sync,
         pairs: &mut Vec<(u32, u32)>,
     ) {
-        self.reset_seen();
-        self.in_shares(
-            points.len(),
-            threads,
-            pairs,
-            |this, range, seen, pairs| {
-                let listed = points[range].iter().map(|&i| i as usize);
-                this.query_points(listed, position, displacement, &keep, seen, pairs)
-            },
-            |(), ()| (),
-        );
-    }
-
-    /// As [`BroadPhase::count_edge_pairs`], over the pairs with at least one `moving`
-    /// edge: each such pair once, the smallest (j, k), j < k.
-    pub fn count_moving_edge_pairs(
-        &mut self,
-        threads: usize,
-        moving: &[bool],
-        test: impl Fn(u32, u32) -> bool + Sync,
-    ) -> (usize, Option<(u32, u32)>) {
-        self.reset_seen();
-        let n = self.edge_boxes.len();
-        let mut none = Vec::new();
-        self.in_shares(
-            n,
-            threads,
-            &mut none,
-            |this, range, seen, _| {
-                let (mut count, mut first) = (0, None);
-                for j in range.filter(|&j| moving[j]) {
-                    let j = j as u32;
-                    let query: Aabb = this.edge_boxes[j as usize];
-                    let cells = this.edge_cells[j as usize];
-                    this.visit_cells(&query, cells, (seen, j + 1), 0, |k| {
-                        // A pair of moving edges is counted from its lower edge.
-                        let counted = k != j && (!moving[k as usize] || j < k);
-                        if counted && test(j, k) {
-                            count += 1;
-                            let pair = (j.min(k), j.max(k));
-                            first = Some(first.map_or(pair, |f: (u32, u32)| f.min(pair)));
-                        }
-                    });
-                }
-                (count, first)
-            },
-            |(count, found): (usize, Option<(u32, u32)>), (c, f)| {
-                let first = match (found, f) {
-                    (Some(a), Some(b)) => Some(a.min(b)),
-                    (a, b) => a.or(b),
-                };
-                (count + c, first)
-            },
-        )
+        let point = |k: usize| points[k] as usize;
+        let n = points.len();
+        self.query_shares(threads, n, point, position, displacement, keep, pairs);
     }
 }
 
@@ -115,12 +69,6 @@ impl StillScratch {
     /// (and nothing listed) when fewer than [`STILL_SHARE`] stand still.
     pub fn split(&mut self, edges: &[Edge], inverse_mass: &[f64], displacement: &[DVec2]) -> bool {
         let n = displacement.len().min(inverse_mass.len());
-        let still = (0..n)
-            .filter(|&i| is_still(inverse_mass, displacement, i))
-            .count();
-        if n == 0 || (still as f64) < STILL_SHARE * n as f64 {
-            return false;
-        }
         self.moving_points.clear();
         self.still_points.clear();
         for i in 0..n as u32 {
@@ -129,6 +77,9 @@ impl StillScratch {
             } else {
                 self.moving_points.push(i);
             }
+        }
+        if !mostly_still(self.still_points.len(), n) {
+            return false;
         }
         self.edges.clear();
         self.edge_index.clear();
@@ -238,7 +189,7 @@ mod tests {
         for threads in [1, 2] {
             let mut broad = BroadPhase::default();
             broad.build(&edges, &position, None, 0.0, threads);
-            let (count, first) = broad.count_moving_edge_pairs(threads, &moving, crossed);
+            let (count, first) = broad.count_edge_pairs(threads, Some(&moving), crossed);
             assert_eq!((count, first), (all.len(), all.first().copied()));
         }
     }

@@ -76,11 +76,12 @@ pub struct StrandsConfig {
     pub sleep: SleepConfig,
 }
 
-/// Sleeping: strands whose every particle has stayed within `drift` of one place for
-/// `time` seconds, as have the awake strands they touch, go to sleep — held exactly where it is, at no cost to
-/// a step but being collided against — and each of its strands wakes when something
-/// moving comes within reach of it, when one of its particles is written to, or when
-/// one of its anchors moves (see [`crate::sleeping`]).
+/// Sleeping: a strand whose every particle has stayed within `drift` of one place for
+/// `time` seconds, as have the awake strands it touches, goes to sleep — held exactly
+/// where it is, at no cost to a step but being collided against — and wakes when
+/// something moving comes within reach of it, when one of its particles is written to,
+/// when one of its anchors moves, or when what it rests on is despawned (see the
+/// `sleeping` module).
 #[derive(Reflect, Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(
     feature = "serde",

@@ -71,11 +71,12 @@ pub struct Frozen;
 
 /// A particle at rest in a sleeping strand: held like a pinned one, with zero velocity,
 /// its position kept exactly, and no cost to a step beyond being collided against. The
-/// sleeping system ([`crate::sleeping`]) adds it to every particle of a group of
-/// strands that has stayed slow for [`SleepConfig::time`](crate::world::config::SleepConfig)
-/// and removes it when something moving comes within reach, when a particle of the
-/// strand is written to, or when one of its anchors moves. Removing it yourself wakes
-/// the particle's strand.
+/// sleeping system (the `sleeping` module) adds it to every particle of a strand that
+/// has stayed within [`SleepConfig::drift`](crate::world::config::SleepConfig) of one
+/// place for its `time`, as have the awake strands it touches, and removes it when
+/// something moving comes within reach, when a particle of the strand is written to,
+/// when one of its anchors moves, or when what it rests on is despawned. Removing it
+/// yourself wakes the particle's strand.
 #[derive(Component, Reflect, Clone, Copy, Debug, Default)]
 #[reflect(Component)]
 #[component(on_add = on_structure_changed, on_remove = on_structure_changed)]
