@@ -1,11 +1,12 @@
-//! What a game's frame costs: the worlds of the `game` and `physics_world` examples
-//! (`bevy_strands_app::worlds`), headless on `MinimalPlugins`, each frame one 1/60 s
-//! fixed tick (the strands in 10 substeps; avian's step too in `physics_world`). First
+//! What a game's frame costs: the worlds of the `game`, `physics_world` and
+//! `rapier_world` examples (`bevy_strands_app::worlds`), headless on `MinimalPlugins`,
+//! each frame one 1/60 s fixed tick (the strands in 10 substeps; avian's or Rapier's
+//! step too in the two bodies worlds). First
 //! ten simulated seconds from the spawn are timed frame by frame — the crates drop,
 //! land and settle, the lantern swings, the hair falls — and their median, 99th
 //! percentile and worst printed; then criterion times a frame of the settled world. On
 //! one and two threads. Run with
-//! `cargo bench -p bevy_strands_app --features avian --bench frame`; results per
+//! `cargo bench -p bevy_strands_app --features avian,rapier --bench frame`; results per
 //! machine are in `benches/RESULTS.md`.
 
 use std::time::{Duration, Instant};
@@ -18,36 +19,60 @@ use bevy_strands_app::worlds::game::{game_config, spawn_game_world};
 use bevy_strands_app::worlds::physics_world::{
     PhysicsWorldPlugin, physics_world_config, spawn_physics_world,
 };
+use bevy_strands_app::worlds::rapier_world::{
+    RapierWorldPlugin, rapier_world_config, spawn_rapier_world,
+};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 
 const FRAME: f64 = 1.0 / 60.0;
 
+/// Which example's world.
+#[derive(Clone, Copy, PartialEq)]
+enum World {
+    Game,
+    Avian,
+    Rapier,
+}
+
 /// A headless app whose every update is one fixed tick of 1/60 s.
-fn headless(physics: bool, threads: usize) -> App {
+fn headless(world: World, threads: usize) -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin, StrandsPlugin::default()))
         .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(FRAME)))
         .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
             FRAME,
         )));
-    if physics {
-        app.add_plugins((
-            PhysicsPlugins::default(),
-            StrandsAvianPlugin::default(),
-            PhysicsWorldPlugin,
-        ))
-        .insert_resource(physics_world_config());
-    } else {
-        app.insert_resource(game_config());
+    match world {
+        World::Game => {
+            app.insert_resource(game_config());
+        }
+        World::Avian => {
+            app.add_plugins((
+                PhysicsPlugins::default(),
+                StrandsAvianPlugin::default(),
+                PhysicsWorldPlugin,
+            ))
+            .insert_resource(physics_world_config());
+        }
+        World::Rapier => {
+            app.add_plugins((RapierWorldPlugin, StrandsRapierPlugin::default()))
+                .insert_resource(rapier_world_config());
+        }
     }
     app.world_mut().resource_mut::<StrandsConfig>().threads = threads;
     app.finish();
     app.cleanup();
     let mut commands = app.world_mut().commands();
-    if physics {
-        spawn_physics_world(&mut commands);
-    } else {
-        spawn_game_world(&mut commands);
+    match world {
+        World::Game => {
+            spawn_game_world(&mut commands);
+        }
+        World::Avian => {
+            spawn_physics_world(&mut commands);
+        }
+        World::Rapier => {
+            spawn_rapier_world(&mut commands);
+        }
     }
     app.world_mut().flush();
     // The first update starts the clocks; the fixed tick runs from the second.
@@ -72,9 +97,14 @@ fn frame(c: &mut Criterion) {
         .sample_size(20)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4));
-    for (name, physics) in [("game", false), ("physics_world", true)] {
+    let worlds = [
+        ("game", World::Game),
+        ("physics_world", World::Avian),
+        ("rapier_world", World::Rapier),
+    ];
+    for (name, world) in worlds {
         for threads in [1usize, 2] {
-            let mut app = headless(physics, threads);
+            let mut app = headless(world, threads);
             let mut times = frames(&mut app, 600);
             times.sort();
             let ms = |d: Duration| d.as_secs_f64() * 1e3;

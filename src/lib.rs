@@ -37,6 +37,8 @@
 pub mod anchors;
 #[cfg(feature = "avian")]
 pub mod avian;
+#[cfg(any(feature = "avian", feature = "rapier"))]
+pub mod bodies;
 pub mod colliders;
 pub mod collision;
 pub mod constraints;
@@ -48,6 +50,8 @@ pub mod integrate;
 pub mod metrics;
 pub mod model;
 pub mod parallel;
+#[cfg(feature = "rapier")]
+pub mod rapier;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod ribbon;
@@ -84,7 +88,9 @@ use world::topology::{Topology, detect_strand_edits, rebuild_topology, topology_
 pub mod prelude {
     pub use crate::anchors::Anchor;
     #[cfg(feature = "avian")]
-    pub use crate::avian::{BodyAnchor, CollidesWithStrands, StrandsAvianPlugin};
+    pub use crate::avian::StrandsAvianPlugin;
+    #[cfg(any(feature = "avian", feature = "rapier"))]
+    pub use crate::bodies::{BodyAnchor, BodyView, CollidesWithStrands};
     pub use crate::colliders::{ColliderShape, StrandCollider};
     pub use crate::collision::CollisionPlugin;
     pub use crate::constraints::projection::ContactSolver;
@@ -92,6 +98,8 @@ pub mod prelude {
     pub use crate::contact_events::StrandContact;
     pub use crate::guard::{FiniteGuard, NonFiniteState};
     pub use crate::metrics::StrandMetrics;
+    #[cfg(feature = "rapier")]
+    pub use crate::rapier::StrandsRapierPlugin;
     pub use crate::schedule::{
         CollideSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
     };

@@ -1,61 +1,35 @@
-//! Strands in an avian2d world (feature `avian`; avian's default `f32` build).
+//! Strands in an avian2d world (feature `avian`): avian's adapter to the engine-neutral
+//! coupling in [`bodies`](crate::bodies).
 //!
-//! - A collider marked [`CollidesWithStrands`] gets an outline strand, as the crate's
-//!   own [`StrandCollider`](crate::colliders::StrandCollider)s do: strands meet it
-//!   through the same continuous detection, impulses and fail-safe. On a dynamic body
-//!   the outline's vertices carry the body's mass, and what strands push on them goes
-//!   back to the body ([`coupling`]).
-//! - A particle with a [`BodyAnchor`] hangs on a body: a crate on a rope pulls the rope
-//!   down and the rope holds it up, with every edge exact.
+//! - A collider marked [`CollidesWithStrands`] gets an outline strand; on a dynamic
+//!   body a frame carrying the body's mass, and what strands push on it goes back to
+//!   the body.
+//! - A particle with a [`BodyAnchor`] hangs on a body, both ways.
 //! - Gravity is avian's ([`Gravity`]) unless [`StrandsAvianPlugin::share_gravity`] is
 //!   off.
 //!
 //! Avian works in `f32`, the strands in `f64`: values are converted at this boundary
 //! only. A tick of the strands runs after avian's step in the same schedule, starting
 //! from the bodies' new poses and velocities; the impulses it measures reach the bodies
-//! before avian's next step.
+//! as forces over avian's next step.
 
-pub mod anchor;
-pub mod coupling;
-pub mod shapes;
-pub mod truss;
-
+use bevy::math::Rot2;
 use bevy::prelude::*;
 
 use avian2d::prelude::{
-    Collider, ComputedCenterOfMass, Gravity, PhysicsSystems, RigidBody, Rotation,
+    AngularVelocity, Collider, ColliderOf, ComputedAngularInertia, ComputedCenterOfMass,
+    ComputedMass, Forces, Gravity, LinearVelocity, PhysicsLengthUnit, PhysicsSystems, Position,
+    RigidBody, Rotation, Sleeping, WriteRigidBodyForces,
 };
 
-use crate::colliders::{
-    ColliderShape, OutlineBuild, StrandCollider, spawn_anchored_outline, spawn_outline,
+use crate::bodies::shapes::shape_outline;
+pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
+use crate::bodies::{
+    BodyCouplingPlugin, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider,
+    drop_outline, outline_collider,
 };
-use crate::rollback::{RollbackApp, StepRollback};
-use crate::schedule::{
-    CollideSet, ConstrainSet, StepSet, StrandsStep, StrandsSystems, StrandsTick, TickSet,
-};
-use crate::world::config::StrandsConfig;
-use crate::world::particle::Kinematic;
-pub use anchor::BodyAnchor;
-pub use coupling::BodyCoupling;
-use truss::{OutlineVertex, spawn_truss};
-
-/// Make strands collide with this avian collider, its curves drawn within `tolerance`.
-#[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
-#[reflect(Component)]
-pub struct CollidesWithStrands {
-    /// How far the outline's polygon may stand off a curve.
-    pub tolerance: f32,
-}
-
-impl Default for CollidesWithStrands {
-    fn default() -> Self {
-        Self { tolerance: 1e-3 }
-    }
-}
-
-/// On a collider whose outline this module built (or refused to build).
-#[derive(Component, Clone, Copy, Debug, Default)]
-struct AvianOutline;
+use crate::schedule::{StrandsSystems, StrandsTick, TickSet};
+use crate::world::config::{LengthUnit, StrandsConfig};
 
 /// Couples the strands with avian2d. Add it after [`StrandsPlugin`](crate::StrandsPlugin)
 /// and avian's `PhysicsPlugins`.
@@ -75,21 +49,12 @@ impl Default for StrandsAvianPlugin {
 
 impl Plugin for StrandsAvianPlugin {
     fn build(&self, app: &mut App) {
-        // No step that couples a body is taken again in halves: avian moves its bodies
-        // between ticks, so an anchored end starts the tick off its length by what
-        // avian moved it, and half the step corrects that twice as fast (a rope of a
-        // two-thousandth of its crate flew apart).
-        app.init_resource::<StepRollback>();
-        app.world_mut()
-            .resource_mut::<StepRollback>()
-            .forbid_when(|world| {
-                world
-                    .get_resource::<BodyCoupling>()
-                    .is_some_and(BodyCoupling::couples)
-            });
-        app.register_type::<CollidesWithStrands>()
-            .register_type::<BodyAnchor>()
-            .init_resource::<BodyCoupling>()
+        if !app.is_plugin_added::<BodyCouplingPlugin>() {
+            app.add_plugins(BodyCouplingPlugin);
+        }
+        // Every avian body is mirrored for the coupling.
+        app.register_required_components::<RigidBody, BodyView>()
+            .register_required_components::<RigidBody, BodyPush>()
             // The strands start from the bodies' new state, whatever schedule drives
             // both (avian's default and the strands' are `FixedPostUpdate`).
             .configure_sets(
@@ -99,34 +64,13 @@ impl Plugin for StrandsAvianPlugin {
             .add_systems(
                 StrandsTick,
                 (
-                    // Before the bodies are followed, so that new ties start taut.
-                    (drop_unmarked, build_body_outlines, truss::rig_anchors)
+                    (mirror_bodies, (drop_unmarked, build_outlines).chain())
                         .chain()
-                        .before(OutlineBuild)
-                        .before(TickSet::Topology),
-                    coupling::follow_bodies.in_set(TickSet::Prepare),
-                    coupling::load_body_masses
-                        .after(TickSet::Gather)
-                        .before(TickSet::Step),
-                    coupling::push_bodies.after(TickSet::Writeback),
+                        .in_set(BodySync::Read),
+                    push_bodies.in_set(BodySync::Write),
                 ),
             )
-            // A step taken again in halves must not count its impulses twice.
-            .roll_back::<BodyCoupling, BodyCoupling>(
-                |coupling, saved| saved.copy_from(coupling),
-                |coupling, saved| coupling.copy_from(saved),
-            )
-            .add_systems(
-                StrandsStep,
-                (
-                    coupling::record_velocities
-                        .in_set(StepSet::Constrain)
-                        .before(ConstrainSet::Project),
-                    coupling::accumulate_impulses
-                        .in_set(StepSet::Collide)
-                        .after(CollideSet::Account),
-                ),
-            );
+            .add_systems(PostStartup, check_length_unit);
         if self.share_gravity {
             app.add_systems(StrandsTick, share_gravity.in_set(TickSet::Prepare));
         }
@@ -143,129 +87,132 @@ fn share_gravity(gravity: Option<Res<Gravity>>, mut config: ResMut<StrandsConfig
     }
 }
 
-/// The outline of each newly marked collider, its vertices attached to the collider's
-/// body (or, for a collider without a body, to its transform).
+/// A world whose two engines measure length differently collides at the wrong
+/// thickness: say so once, at the start.
+fn check_length_unit(avian: Option<Res<PhysicsLengthUnit>>, ours: Option<Res<LengthUnit>>) {
+    let (Some(avian), Some(ours)) = (avian, ours) else {
+        return;
+    };
+    if !crate::bodies::same_length_unit(avian.0 as f64, ours.0) {
+        warn!(
+            "bevy_strands: avian's PhysicsLengthUnit is {} but the strands' LengthUnit is {}: \
+             use StrandsPlugin::with_length_unit({})",
+            avian.0, ours.0, avian.0
+        );
+    }
+}
+
+/// Avian's rotation as an angle (avian's sine and cosine drift off the unit circle by
+/// rounding, which `Rot2::from_sin_cos` refuses).
+fn planar(rotation: &Rotation) -> Rot2 {
+    Rot2::radians(rotation.sin.atan2(rotation.cos))
+}
+
+/// What the coupling mirrors of an avian body.
+type AvianBody = (
+    &'static Position,
+    &'static Rotation,
+    &'static LinearVelocity,
+    &'static AngularVelocity,
+    &'static RigidBody,
+    &'static ComputedMass,
+    &'static ComputedAngularInertia,
+    &'static ComputedCenterOfMass,
+    Has<Sleeping>,
+    &'static mut BodyView,
+);
+
+/// Each avian body's pose, velocity and mass properties into its [`BodyView`].
+fn mirror_bodies(mut bodies: Query<AvianBody>) {
+    for (position, rotation, linear, angular, body, mass, inertia, centre, asleep, mut view) in
+        &mut bodies
+    {
+        let motion = match body {
+            RigidBody::Dynamic => BodyMotion::Dynamic,
+            RigidBody::Kinematic => BodyMotion::Kinematic,
+            RigidBody::Static => BodyMotion::Static,
+        };
+        view.set_if_neq(BodyView {
+            position: position.0,
+            rotation: planar(rotation),
+            linear: linear.0,
+            angular: angular.0,
+            motion,
+            mass: mass.value(),
+            inertia: inertia.value(),
+            centre_of_mass: centre.0,
+            sleeping: asleep,
+        });
+    }
+}
+
+/// The outline of each newly marked avian collider.
 #[allow(clippy::type_complexity)]
-fn build_body_outlines(
+fn build_outlines(
     mut commands: Commands,
     colliders: Query<
         (
             Entity,
             &Collider,
             &CollidesWithStrands,
-            Option<&avian2d::prelude::ColliderOf>,
-            Option<&avian2d::prelude::Position>,
+            Option<&ColliderOf>,
+            Option<&Position>,
             Option<&Rotation>,
             &GlobalTransform,
         ),
-        Without<AvianOutline>,
+        Without<BodyOutline>,
     >,
-    bodies: Query<(
-        &avian2d::prelude::Position,
-        &Rotation,
-        &RigidBody,
-        &ComputedCenterOfMass,
-    )>,
+    bodies: Query<&BodyView>,
 ) {
     for (entity, collider, marker, of, position, rotation, transform) in &colliders {
         commands.entity(entity).insert(AvianOutline);
-        let (points, closed) =
-            match shapes::shape_outline(collider.shape_scaled().as_typed_shape(), marker.tolerance)
-            {
-                Ok(outline) => outline,
-                Err(what) => {
-                    warn!("bevy_strands: collider {entity} is {what}: strands pass through it");
-                    continue;
-                }
-            };
+        let outline = shape_outline(collider.shape_scaled().as_typed_shape(), marker.tolerance);
         let body_entity = of.map_or(entity, |of| of.body);
-        let Ok((body_position, body_rotation, body, centre_of_mass)) = bodies.get(body_entity)
-        else {
-            // No rigid body: a fixed shape where its transform puts it.
-            spawn_anchored_outline(&mut commands, entity, &points, closed, transform);
-            insert_shape(&mut commands, entity, points, closed, marker.tolerance);
-            continue;
-        };
-        // The collider's own pose where avian keeps one (a child collider), else the
-        // body's.
-        let (at, turn) = match (position, rotation) {
-            (Some(p), Some(r)) => (p.0, *r),
-            _ => (body_position.0, *body_rotation),
-        };
-        let world = |p: Vec2| at + turn * p;
-        let offset = |p: Vec2| body_rotation.inverse() * (world(p) - body_position.0);
-        let world_point = |p: Vec2| world(p).as_dvec2();
-        let anchor = |p: Vec2| BodyAnchor {
-            body: body_entity,
-            offset: offset(p),
-        };
-        if !body.is_dynamic() {
-            // A body that forces do not move drives its outline from the start.
-            spawn_outline(&mut commands, entity, &points, closed, world_point, |p| {
-                (anchor(p), Kinematic)
-            });
-        } else {
-            let offsets: Vec<Vec2> = points.iter().map(|&p| offset(p)).collect();
-            let spread: f64 = offsets
-                .iter()
-                .map(|&o| (o - centre_of_mass.0).length_squared() as f64)
-                .sum();
-            let role = OutlineVertex {
-                centre: false,
-                vertices: points.len() as u32,
-                inverse_spread: 1.0 / spread,
-                framed: closed,
+        let body = bodies.get(body_entity).ok().map(|body| {
+            // The collider's own pose where avian keeps one (a child collider), else
+            // the body's.
+            let (at, turn) = match (position, rotation) {
+                (Some(p), Some(r)) => (body.local_point(p.0), body.rotation.inverse() * planar(r)),
+                _ => (Vec2::ZERO, Rot2::IDENTITY),
             };
-            let spawned = spawn_outline(&mut commands, entity, &points, closed, world_point, |p| {
-                (anchor(p), role)
-            });
-            if let (Some((_, vertices)), true) = (spawned, closed) {
-                let body_world = |p: Vec2| (body_position.0 + *body_rotation * p).as_dvec2();
-                spawn_truss(
-                    &mut commands,
-                    (entity, body_entity),
-                    (&vertices, &offsets),
-                    centre_of_mass.0,
-                    role,
-                    body_world,
-                );
-            }
-        }
-        insert_shape(&mut commands, entity, points, closed, marker.tolerance);
+            (body_entity, body, at, turn)
+        });
+        outline_collider(
+            &mut commands,
+            MarkedCollider {
+                entity,
+                outline,
+                body,
+                transform,
+                marker: *marker,
+            },
+        );
     }
 }
 
-/// The collider's outline as a [`StrandCollider`] too, so it is seen (and removed) as
-/// every other collider outline is.
-fn insert_shape(
-    commands: &mut Commands,
-    entity: Entity,
-    points: Vec<Vec2>,
-    closed: bool,
-    tolerance: f32,
-) {
-    commands.entity(entity).insert(StrandCollider {
-        shape: ColliderShape::Polyline { points, closed },
-        tolerance,
-    });
-}
+/// On a collider whose outline was built from avian's shape.
+#[derive(Component, Clone, Copy, Debug, Default)]
+struct AvianOutline;
 
-/// A collider no longer marked (or no longer a collider) loses its outline.
-#[allow(clippy::type_complexity)]
+/// A collider that is no longer avian's loses its outline.
 fn drop_unmarked(
     mut commands: Commands,
-    outlined: Query<
-        Entity,
-        (
-            With<AvianOutline>,
-            Or<(Without<CollidesWithStrands>, Without<Collider>)>,
-        ),
-    >,
+    outlined: Query<Entity, (With<AvianOutline>, Without<Collider>)>,
 ) {
     for entity in &outlined {
-        // The outline strand goes with the collider's StrandCollider.
-        commands
-            .entity(entity)
-            .remove::<(AvianOutline, StrandCollider)>();
+        commands.entity(entity).remove::<AvianOutline>();
+        drop_outline(&mut commands, entity);
+    }
+}
+
+/// The strands' pushes as forces over avian's next step.
+fn push_bodies(mut bodies: Query<(&mut BodyPush, Forces)>) {
+    for (mut push, mut forces) in &mut bodies {
+        if *push == BodyPush::default() {
+            continue;
+        }
+        let BodyPush { force, torque } = std::mem::take(&mut *push);
+        forces.apply_force(force);
+        forces.apply_torque(torque);
     }
 }

@@ -1,4 +1,5 @@
-//! Two-way coupling of particles with avian rigid bodies.
+//! Two-way coupling of particles with rigid bodies, through the engine-neutral
+//! [`BodyView`] and [`BodyPush`].
 //!
 //! A particle attached to a dynamic body ([`BodyAnchor`]) is simulated, for the tick,
 //! as a free particle carrying a share of the body's mass: a vertex or the centre of
@@ -9,20 +10,16 @@
 //! step the impulse the constraints and contacts gave it is measured (its momentum
 //! after the collision stage less after the predictor), with its moment about the
 //! body's centre of mass; at the tick's end the body's share goes to the body as a
-//! force and a torque over avian's next step. A particle on a static or kinematic body
+//! force and a torque over the engine's next step ([`BodyPush`]). A particle on a static or kinematic body
 //! is [`Kinematic`] instead: infinite mass, moving with the body.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-use avian2d::prelude::{
-    AngularVelocity, ComputedAngularInertia, ComputedCenterOfMass, ComputedMass, Forces,
-    LinearVelocity, RigidBody, Rotation, WriteRigidBodyForces,
-};
-
 use super::anchor::BodyAnchor;
 use super::shapes::effective_mass;
 use super::truss::{OutlineVertex, Rigged};
+use super::view::{BodyPush, BodyView};
 use crate::world::config::{CollisionConfig, StrandsConfig};
 use crate::world::particle::{Kinematic, Position, SolverIndex, Velocity};
 use crate::world::problems::InputProblems;
@@ -80,33 +77,6 @@ impl BodyCoupling {
     }
 }
 
-/// The avian data of a body that the coupling reads.
-type BodyData = (
-    &'static avian2d::prelude::Position,
-    &'static Rotation,
-    &'static LinearVelocity,
-    &'static AngularVelocity,
-    &'static RigidBody,
-    &'static ComputedMass,
-    &'static ComputedAngularInertia,
-    &'static ComputedCenterOfMass,
-);
-
-/// The world point of `offset` on a body at `position` turned by `rotation`, moving
-/// with `linear` and `angular` velocity about its centre of mass (`centre_of_mass` in
-/// its frame): the point, its velocity, and the arm from the centre of mass.
-pub(super) fn body_point(
-    (position, rotation): (Vec2, Rotation),
-    (linear, angular): (Vec2, f32),
-    centre_of_mass: Vec2,
-    offset: Vec2,
-) -> (DVec2, DVec2, Vec2) {
-    let point = position + rotation * offset;
-    let arm = point - (position + rotation * centre_of_mass);
-    let velocity = linear + angular * arm.perp();
-    (point.as_dvec2(), velocity.as_dvec2(), arm)
-}
-
 /// What the coupling reads and writes of an anchored particle.
 type AnchorData = (
     Entity,
@@ -128,7 +98,7 @@ pub(super) fn follow_bodies(
     mut particles: Query<AnchorData>,
     mut positions: ParamSet<(Query<&Position>, Query<&mut Position>)>,
     strands: Query<&Strand>,
-    bodies: Query<BodyData>,
+    bodies: Query<&BodyView>,
     collisions: Res<CollisionConfig>,
     mut moves: Local<Vec<(Entity, DVec2)>>,
     mut problems: ResMut<InputProblems>,
@@ -153,17 +123,16 @@ pub(super) fn follow_bodies(
             problems.report(
                 entity,
                 format!(
-                    "body anchor {} is not an avian rigid body: held still",
+                    "body anchor {} is not a rigid body: held still",
                     anchor.body
                 ),
             );
             velocity.set_if_neq(Velocity(DVec2::ZERO));
             continue;
         };
-        let (pose, motion) = ((body.0.0, *body.1), (body.2.0, body.3.0));
         let offset = rigged.map_or(anchor.offset, |r| r.offset);
-        let (point, point_velocity, arm) = body_point(pose, motion, body.7.0, offset);
-        let dynamic = body.4.is_dynamic();
+        let (point, point_velocity, arm) = body.point_motion(offset);
+        let dynamic = body.is_dynamic();
         let off = point - position.0;
         if dynamic && off.length() < snap {
             moves.push((entity, point));
@@ -182,12 +151,12 @@ pub(super) fn follow_bodies(
         if !dynamic || rigged.is_some() {
             continue;
         }
-        // A body avian has not given its mass properties yet (spawned this frame) is
-        // followed, not coupled.
-        let (mass, inertia) = (body.5.value() as f64, body.6.value() as f64);
-        if !(mass.is_finite() && mass > 0.0 && inertia > 0.0) {
+        // A body the engine has not given its mass properties yet (spawned this frame)
+        // is followed, not coupled.
+        if !body.has_mass() {
             continue;
         }
+        let (mass, inertia) = (body.mass as f64, body.inertia as f64);
         let body_mass = match vertex {
             Some(vertex) => vertex.mass(mass, inertia),
             None => {
@@ -353,13 +322,14 @@ pub(super) fn accumulate_impulses(mut coupling: ResMut<BodyCoupling>, state: Res
 }
 
 /// At the tick's end: each body's share of its particles' impulses and their moments,
-/// as a force and a torque spread over avian's next step, which covers the same time.
+/// as a force and a torque spread over the engine's next step, which covers the same
+/// time.
 /// Spread, not at once: gravity acts on the body through that step, and a rope that
 /// holds the body up must act with it, or the body jumps up and falls back every tick.
 pub(super) fn push_bodies(
     coupling: Res<BodyCoupling>,
     config: Res<StrandsConfig>,
-    mut bodies: Query<Forces>,
+    mut bodies: Query<&mut BodyPush>,
 ) {
     let tick = config.tick_seconds();
     for c in coupling.coupled.iter().filter(|c| c.index != u32::MAX) {
@@ -368,9 +338,9 @@ pub(super) fn push_bodies(
         if !(force.is_finite() && torque.is_finite()) {
             continue;
         }
-        if let Ok(mut body) = bodies.get_mut(c.body) {
-            body.apply_force(force.as_vec2());
-            body.apply_torque(torque as f32);
+        if let Ok(mut push) = bodies.get_mut(c.body) {
+            push.force += force.as_vec2();
+            push.torque += torque as f32;
         }
     }
 }

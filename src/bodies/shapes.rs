@@ -1,16 +1,16 @@
-//! Avian collider shapes as strand outlines, and the mass a body shows at a point: pure
+//! Collider shapes (parry's, which both avian and Rapier use) as strand outlines, and the mass a body shows at a point: pure
 //! functions, no ECS.
 
-use avian2d::parry::shape::TypedShape;
 use bevy::math::Vec2;
+use parry2d::shape::TypedShape;
 
 use crate::colliders::{ColliderShape, outline};
 
-/// The outline of an avian (parry) shape in the collider's frame, curves within
+/// The outline of a parry shape in the collider's frame, curves within
 /// `tolerance`: its vertices and whether it closes. `Err` names a shape with no
 /// outline here (compounds, meshes, height fields, half-spaces, voxels).
 pub fn shape_outline(shape: TypedShape<'_>, tolerance: f32) -> Result<(Vec<Vec2>, bool), String> {
-    let v = |p: avian2d::parry::math::Vector| Vec2::new(p.x, p.y);
+    let v = |p: parry2d::math::Vector| Vec2::new(p.x, p.y);
     Ok(match shape {
         TypedShape::Ball(ball) => outline(
             &ColliderShape::Circle {
@@ -114,7 +114,7 @@ pub fn effective_mass(mass: f64, inertia: f64, r: Vec2, direction: Option<Vec2>)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use avian2d::parry::shape::{Ball, Capsule, Cuboid, Polyline, Segment};
+    use parry2d::shape::{Ball, Capsule, Cuboid, Polyline, Segment};
 
     #[test]
     fn a_capsule_along_y_is_turned_onto_its_segment() {

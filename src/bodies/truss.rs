@@ -7,15 +7,15 @@
 //! (the frame's inertia is the body's), the centre the rest of the mass (the frame's
 //! mass is the body's). A strand that lands on the body therefore meets the body's own
 //! mass and inertia inside the step, both ways at once; only what happens to the body
-//! in avian (its other contacts, joints, the user's forces) reaches the strands a tick
-//! late. A particle anchored to such a body is tied into the frame by two edges to the
+//! in its engine (its other contacts, joints, the user's forces) reaches the strands a
+//! tick late. A particle anchored to such a body is tied into the frame by two edges to the
 //! nearest outline edge's ends ([`Rigged`]), so a rope hangs on the frame itself.
 
-use avian2d::prelude::Rotation;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::anchor::BodyAnchor;
+use super::view::BodyView;
 use crate::colliders::ColliderOf;
 use crate::model::validate::rest_lengths_of;
 use crate::world::particle::{Particle, Position, Velocity};
@@ -151,7 +151,7 @@ pub(super) fn rig_anchors(
     mut commands: Commands,
     anchors: Query<(Entity, &BodyAnchor, &Position, Option<&Rigged>), Without<OutlineVertex>>,
     positions: Query<&Position>,
-    trusses: Query<(&BodyTruss, &avian2d::prelude::Position, &Rotation)>,
+    trusses: Query<(&BodyTruss, &BodyView)>,
     strands: Query<(), With<Strand>>,
 ) {
     for (particle, anchor, position, rigged) in &anchors {
@@ -161,18 +161,18 @@ pub(super) fn rig_anchors(
             }
             commands.entity(particle).remove::<Rigged>();
         }
-        let Ok((truss, body_position, body_rotation)) = trusses.get(anchor.body) else {
+        let Ok((truss, body)) = trusses.get(anchor.body) else {
             continue;
         };
         // Tied where it is (a tick's motion off its anchor point at most), so that the
         // ties start at their length; it is held there on the body from now on.
         let at = position.0;
-        let offset = body_rotation.inverse() * (at.as_vec2() - body_position.0);
+        let offset = body.local_point(at.as_vec2());
         let (hub, centre) = truss.hub;
         let Some(k) = stoutest_vertex(&truss.offsets, centre, offset) else {
             continue;
         };
-        let world = |p: Vec2| (body_position.0 + *body_rotation * p).as_dvec2();
+        let world = |p: Vec2| body.world_point(p).as_dvec2();
         let mut links = [Entity::PLACEHOLDER; 2];
         for (link, (other, at_other)) in links
             .iter_mut()

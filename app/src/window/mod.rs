@@ -15,6 +15,8 @@
 //!     .run();
 //! ```
 
+#[cfg(any(feature = "avian", feature = "rapier"))]
+pub mod bodies;
 mod layout;
 mod pace;
 pub mod page;

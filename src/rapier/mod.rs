@@ -1,0 +1,238 @@
+//! Strands in a bevy_rapier2d world (feature `rapier`): Rapier's adapter to the
+//! engine-neutral coupling in [`bodies`](crate::bodies), at parity with avian's.
+//!
+//! - A collider marked [`CollidesWithStrands`] gets an outline strand; on a dynamic
+//!   body a frame carrying the body's mass, and what strands push on it goes back to
+//!   the body.
+//! - A particle with a [`BodyAnchor`] hangs on a body, both ways.
+//! - Gravity is Rapier's (the default context's [`RapierConfiguration`]) unless
+//!   [`StrandsRapierPlugin::share_gravity`] is off.
+//!
+//! Run Rapier in the fixed schedule (`RapierPhysicsPlugin::default().in_fixed_schedule()`,
+//! or `in_schedule(FixedPostUpdate)`): the strands' tick then starts from the bodies'
+//! new poses, and their pushes act over Rapier's next step as an [`ExternalForce`]
+//! (added to whatever force the game sets, and taken off again a tick later). Bodies
+//! are read from their `Transform`, so a coupled body sits at the root of its
+//! hierarchy, as Rapier's own bodies normally do; a collider may be the body's child.
+
+use bevy::math::Rot2;
+use bevy::prelude::*;
+
+use bevy_rapier2d::plugin::PhysicsSet;
+use bevy_rapier2d::prelude::{
+    Collider, ExternalForce, LockedAxes, RapierConfiguration, RapierContextSimulation,
+    ReadMassProperties, RigidBody, Sleeping, Velocity,
+};
+
+use crate::bodies::shapes::shape_outline;
+pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
+use crate::bodies::{
+    BodyCouplingPlugin, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider,
+    drop_outline, outline_collider,
+};
+use crate::schedule::{StrandsSystems, StrandsTick, TickSet};
+use crate::world::config::{LengthUnit, StrandsConfig};
+
+/// Couples the strands with bevy_rapier2d. Add it after
+/// [`StrandsPlugin`](crate::StrandsPlugin) and `RapierPhysicsPlugin`.
+#[derive(Clone, Copy, Debug)]
+pub struct StrandsRapierPlugin {
+    /// Use Rapier's gravity for the strands, every tick.
+    pub share_gravity: bool,
+}
+
+impl Default for StrandsRapierPlugin {
+    fn default() -> Self {
+        Self {
+            share_gravity: true,
+        }
+    }
+}
+
+impl Plugin for StrandsRapierPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<BodyCouplingPlugin>() {
+            app.add_plugins(BodyCouplingPlugin);
+        }
+        // Every Rapier body is mirrored for the coupling; its velocity is written back
+        // by Rapier only where it has a Velocity, and the strands' force goes through
+        // an ExternalForce.
+        app.register_required_components::<RigidBody, BodyView>()
+            .register_required_components::<RigidBody, BodyPush>()
+            .register_required_components::<RigidBody, Velocity>()
+            .register_required_components::<RigidBody, ExternalForce>()
+            .register_required_components::<RigidBody, PushedForce>()
+            // Rapier stepped in `FixedPostUpdate` goes first too.
+            .configure_sets(FixedPostUpdate, StrandsSystems.after(PhysicsSet::Writeback))
+            .add_systems(
+                StrandsTick,
+                (
+                    (mirror_bodies, (drop_unmarked, build_outlines).chain())
+                        .chain()
+                        .in_set(BodySync::Read),
+                    push_bodies.in_set(BodySync::Write),
+                ),
+            )
+            .add_systems(PostStartup, check_length_unit);
+        if self.share_gravity {
+            app.add_systems(StrandsTick, share_gravity.in_set(TickSet::Prepare));
+        }
+    }
+}
+
+/// The strands fall as the bodies do (the first Rapier context's gravity).
+fn share_gravity(contexts: Query<&RapierConfiguration>, mut config: ResMut<StrandsConfig>) {
+    if let Some(rapier) = contexts.iter().next() {
+        let g = rapier.gravity.as_dvec2();
+        if g.is_finite() && config.gravity != g {
+            config.gravity = g;
+        }
+    }
+}
+
+/// A world whose two engines measure length differently collides at the wrong
+/// thickness: say so once, at the start.
+fn check_length_unit(contexts: Query<&RapierContextSimulation>, ours: Option<Res<LengthUnit>>) {
+    let (Some(rapier), Some(ours)) = (contexts.iter().next(), ours) else {
+        return;
+    };
+    let unit = rapier.integration_parameters.length_unit;
+    if !crate::bodies::same_length_unit(unit as f64, ours.0) {
+        warn!(
+            "bevy_strands: Rapier's length unit is {unit} but the strands' LengthUnit is {}: \
+             use StrandsPlugin::with_length_unit({unit})",
+            ours.0
+        );
+    }
+}
+
+/// What the coupling mirrors of a Rapier body.
+type RapierBody = (
+    &'static Transform,
+    &'static Velocity,
+    &'static RigidBody,
+    &'static ReadMassProperties,
+    Option<&'static LockedAxes>,
+    Option<&'static Sleeping>,
+    &'static mut BodyView,
+);
+
+/// The angle of a rotation about the z axis.
+fn planar_rotation(rotation: Quat) -> Rot2 {
+    Rot2::radians(2.0 * rotation.z.atan2(rotation.w))
+}
+
+/// Each Rapier body's pose, velocity and mass properties into its [`BodyView`].
+fn mirror_bodies(mut bodies: Query<RapierBody>) {
+    for (transform, velocity, body, mass, locked, sleeping, mut view) in &mut bodies {
+        let motion = match body {
+            RigidBody::Dynamic => BodyMotion::Dynamic,
+            RigidBody::KinematicPositionBased | RigidBody::KinematicVelocityBased => {
+                BodyMotion::Kinematic
+            }
+            RigidBody::Fixed => BodyMotion::Static,
+        };
+        let rotation_locked = locked.is_some_and(|l| l.contains(LockedAxes::ROTATION_LOCKED));
+        let inertia = if rotation_locked {
+            f32::INFINITY
+        } else {
+            mass.principal_inertia
+        };
+        view.set_if_neq(BodyView {
+            position: transform.translation.truncate(),
+            rotation: planar_rotation(transform.rotation),
+            linear: velocity.linear,
+            angular: velocity.angular,
+            motion,
+            mass: mass.mass,
+            inertia,
+            centre_of_mass: mass.local_center_of_mass,
+            sleeping: sleeping.is_some_and(|s| s.sleeping),
+        });
+    }
+}
+
+/// The outline of each newly marked Rapier collider: on its own body, or on the body of
+/// the nearest ancestor that has one (its pose composed from the transforms between).
+#[allow(clippy::type_complexity)]
+fn build_outlines(
+    mut commands: Commands,
+    colliders: Query<
+        (Entity, &Collider, &CollidesWithStrands, &GlobalTransform),
+        Without<BodyOutline>,
+    >,
+    bodies: Query<&BodyView>,
+    parents: Query<(&ChildOf, &Transform)>,
+) {
+    for (entity, collider, marker, transform) in &colliders {
+        commands.entity(entity).insert(RapierOutline);
+        let outline = shape_outline(collider.raw.as_typed_shape(), marker.tolerance);
+        // Walk up to the body, composing the collider's pose in its frame.
+        let (mut at, mut turn, mut on) = (Vec2::ZERO, Rot2::IDENTITY, entity);
+        let mut body = None;
+        for _ in 0..16 {
+            if let Ok(view) = bodies.get(on) {
+                body = Some((on, view, at, turn));
+                break;
+            }
+            let Ok((parent, local)) = parents.get(on) else {
+                break;
+            };
+            let local_turn = planar_rotation(local.rotation);
+            at = local.translation.truncate() + local_turn * at;
+            turn = local_turn * turn;
+            on = parent.parent();
+        }
+        outline_collider(
+            &mut commands,
+            MarkedCollider {
+                entity,
+                outline,
+                body,
+                transform,
+                marker: *marker,
+            },
+        );
+    }
+}
+
+/// On a collider whose outline was built from Rapier's shape.
+#[derive(Component, Clone, Copy, Debug, Default)]
+struct RapierOutline;
+
+/// A collider that is no longer Rapier's loses its outline.
+fn drop_unmarked(
+    mut commands: Commands,
+    outlined: Query<Entity, (With<RapierOutline>, Without<Collider>)>,
+) {
+    for entity in &outlined {
+        commands.entity(entity).remove::<RapierOutline>();
+        drop_outline(&mut commands, entity);
+    }
+}
+
+/// The part of a body's [`ExternalForce`] that the strands put there last tick.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PushedForce {
+    /// The force.
+    pub force: Vec2,
+    /// The torque.
+    pub torque: f32,
+}
+
+/// The strands' pushes into each body's [`ExternalForce`] for Rapier's next step, in
+/// place of last tick's (Rapier keeps an external force until it is changed).
+fn push_bodies(mut bodies: Query<(&mut BodyPush, &mut PushedForce, &mut ExternalForce)>) {
+    for (mut push, mut pushed, mut external) in &mut bodies {
+        let new = std::mem::take(&mut *push);
+        if new == BodyPush::default() && *pushed == PushedForce::default() {
+            continue;
+        }
+        external.force += new.force - pushed.force;
+        external.torque += new.torque - pushed.torque;
+        *pushed = PushedForce {
+            force: new.force,
+            torque: new.torque,
+        };
+    }
+}

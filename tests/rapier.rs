@@ -1,0 +1,459 @@
+//! Strands in a bevy_rapier2d world, the same scenes as the avian tests: a crate hanging
+//! on a rope, a strand knocking a body, crates on a rope bridge, a crane, a pendulum.
+//! Headless, Rapier (in the fixed schedule) and the strands both driven by the fixed
+//! clock as in a game.
+
+use std::time::Duration;
+
+use bevy::math::DVec2;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use bevy_rapier2d::prelude::*;
+use bevy_strands::bodies::BodyCoupling;
+use bevy_strands::prelude::*;
+use bevy_strands_app::fixtures::{
+    check_crossings, crossings, position, strand_particles, velocity,
+};
+
+const TICK: f64 = 1.0 / 60.0;
+
+/// Rapier and the strands on `MinimalPlugins`, 60 ticks a second; the strands in 10
+/// steps each. `unit` is both engines' length unit (world units per metre).
+fn app_in(gravity: Vec2, unit: f32) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        TransformPlugin,
+        RapierPhysicsPlugin::<NoUserData>::default()
+            .with_length_unit(unit)
+            .in_fixed_schedule(),
+        StrandsPlugin::default().with_length_unit(unit as f64),
+        StrandsRapierPlugin::default(),
+    ))
+    .insert_resource(TimestepMode::Fixed {
+        dt: TICK as f32,
+        substeps: 1,
+    })
+    .insert_resource(Time::<Fixed>::from_duration(Duration::from_secs_f64(TICK)))
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+        TICK,
+    )));
+    app.world_mut().resource_mut::<StrandsConfig>().substeps = 10;
+    check_crossings(&mut app);
+    app.finish();
+    app.cleanup();
+    // The first update makes Rapier's context, whose gravity is then set.
+    app.update();
+    let mut contexts = app.world_mut().query::<&mut RapierConfiguration>();
+    for mut config in contexts.iter_mut(app.world_mut()) {
+        config.gravity = gravity;
+    }
+    app
+}
+
+fn app(gravity: Vec2) -> App {
+    app_in(gravity, 1.0)
+}
+
+/// Run until `seconds` of fixed ticks have run.
+fn run(app: &mut App, seconds: f64) {
+    for _ in 0..(seconds / TICK).round() as usize {
+        app.update();
+    }
+}
+
+fn body_mass(app: &App, body: Entity) -> f64 {
+    app.world().get::<ReadMassProperties>(body).unwrap().mass as f64
+}
+
+fn body_position(app: &App, body: Entity) -> DVec2 {
+    app.world()
+        .get::<Transform>(body)
+        .unwrap()
+        .translation
+        .truncate()
+        .as_dvec2()
+}
+
+fn body_velocity(app: &App, body: Entity) -> DVec2 {
+    app.world()
+        .get::<bevy_rapier2d::prelude::Velocity>(body)
+        .unwrap()
+        .linear
+        .as_dvec2()
+}
+
+fn max_error(app: &App) -> f64 {
+    app.world().resource::<StrandMetrics>().max_rel_length_error
+}
+
+fn crate_body(size: Vec2, density: f32, at: Vec2) -> impl Bundle {
+    (
+        RigidBody::Dynamic,
+        Collider::cuboid(0.5 * size.x, 0.5 * size.y),
+        ColliderMassProperties::Density(density),
+        CollidesWithStrands::default(),
+        Transform::from_translation(at.extend(0.0)),
+    )
+}
+
+/// A crate hangs on a rope: the rope holds it still, each edge stays exact, and what
+/// the coupling gives the crate each tick carries its weight.
+#[test]
+fn a_crate_hangs_still_on_a_rope_that_carries_its_weight() {
+    let g = 9.81;
+    let mut app = app(Vec2::new(0.0, -g as f32));
+    let (n, spacing, particle_mass) = (21, 0.05, 0.01);
+    let rope = StrandBuilder::line(DVec2::new(0.0, 1.0), -DVec2::Y, n, spacing)
+        .mass(particle_mass)
+        .pin_first()
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let hook = Vec2::new(0.0, 0.12);
+    let crate_ = app
+        .world_mut()
+        .spawn(crate_body(Vec2::splat(0.2), 100.0, Vec2::new(0.0, -0.12)))
+        .id();
+    let end = *strand_particles(&app, rope).last().unwrap();
+    app.world_mut().entity_mut(end).insert(BodyAnchor {
+        body: crate_,
+        offset: hook,
+    });
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .sleep
+        .enabled = false;
+    run(&mut app, 1.0);
+    let hung = body_position(&app, crate_);
+    run(&mut app, 1.0);
+
+    let mass = body_mass(&app, crate_);
+    assert!((mass - 4.0).abs() < 1e-4, "crate of {mass} kg");
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    let drift = body_position(&app, crate_).distance(hung);
+    let speed = body_velocity(&app, crate_).length();
+    assert!(
+        drift < 1e-4 && speed < 1e-3,
+        "the crate moved {drift} m, at {speed} m/s"
+    );
+    let below = -0.12 - body_position(&app, crate_).y;
+    assert!(
+        (0.0..3e-3).contains(&below),
+        "the crate hangs {below} m low"
+    );
+    let held: DVec2 = app
+        .world()
+        .resource::<BodyCoupling>()
+        .impulses()
+        .filter(|&(_, body, _)| body == crate_)
+        .map(|(_, _, impulse)| impulse)
+        .sum();
+    let weight_impulse = mass * g * TICK;
+    assert!(
+        (held - DVec2::new(0.0, weight_impulse)).length() < 1e-3 * weight_impulse,
+        "{held} against {weight_impulse} N s"
+    );
+    assert_eq!(crossings(&app), 0);
+}
+
+/// A strand thrown at a body at rest, with no gravity: the body moves off, and the
+/// momentum the strand loses is the body's (to f32 at the boundary).
+#[test]
+fn a_strand_knocks_a_body_and_momentum_is_kept() {
+    let mut app = app(Vec2::ZERO);
+    let (n, particle_mass, speed) = (11, 0.02, 1.0);
+    let strand = StrandBuilder::line(DVec2::new(-0.3, -0.2), DVec2::Y, n, 0.04)
+        .mass(particle_mass)
+        .velocity(DVec2::new(speed, 0.0))
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let body = app
+        .world_mut()
+        .spawn(crate_body(Vec2::splat(0.2), 10.0, Vec2::ZERO))
+        .id();
+    let before = n as f64 * particle_mass * speed;
+    run(&mut app, 1.0);
+    let mass = body_mass(&app, body);
+    let body_momentum = mass * body_velocity(&app, body);
+    let strand_momentum: DVec2 = strand_particles(&app, strand)
+        .iter()
+        .map(|&p| particle_mass * velocity(&app, p))
+        .sum();
+    let total = strand_momentum + body_momentum;
+    assert!(
+        body_momentum.x > 0.2 * before,
+        "the body took {body_momentum}"
+    );
+    assert!(
+        (total - DVec2::new(before, 0.0)).length() < 1e-4 * before,
+        "momentum {total} against {before}"
+    );
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
+
+/// A crate dropped on a sagging rope bridge lands on it and rests on it.
+#[test]
+fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let points = (0..=30).map(|k| {
+        let x = -0.6 + 1.2 * k as f64 / 30.0;
+        DVec2::new(x, -0.15 * (1.0 - x * x / 0.36))
+    });
+    let bridge = StrandBuilder::polyline(points)
+        .mass(0.01)
+        .pin_first()
+        .pin_last()
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let crate_ = app
+        .world_mut()
+        .spawn(crate_body(Vec2::splat(0.2), 25.0, Vec2::new(0.05, 0.3)))
+        .id();
+    let mut speed = 0.0;
+    for k in 0..180 {
+        app.update();
+        if k >= 120 {
+            speed += body_velocity(&app, crate_).length() / 60.0;
+        }
+    }
+    let centre = body_position(&app, crate_);
+    let lowest = strand_particles(&app, bridge)
+        .iter()
+        .map(|&p| position(&app, p).y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        centre.y > lowest + 0.09,
+        "the crate at {centre} is through the bridge (lowest {lowest})"
+    );
+    assert!(
+        speed < 0.05,
+        "the crate still moves at {speed} m/s on average"
+    );
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
+
+/// A crane's kinematic beam (velocity-driven) runs to and fro with a crate on a rope:
+/// the rope follows the beam, the crate swings under it on a rope that stays exact.
+#[test]
+fn a_crane_swings_a_crate_on_a_rope() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let beam = app
+        .world_mut()
+        .spawn((
+            RigidBody::KinematicVelocityBased,
+            Collider::cuboid(0.15, 0.02),
+            Transform::from_xyz(0.0, 1.2, 0.0),
+        ))
+        .id();
+    let (links, spacing) = (21, 0.025);
+    let top = DVec2::new(0.0, 1.175);
+    let end = top - DVec2::Y * spacing * (links - 1) as f64;
+    let hook = 0.056;
+    let load = app
+        .world_mut()
+        .spawn(crate_body(
+            Vec2::splat(0.1),
+            200.0,
+            Vec2::new(end.x as f32, (end.y - hook) as f32),
+        ))
+        .id();
+    let rope = StrandBuilder::line(top, -DVec2::Y, links, spacing)
+        .mass(0.01)
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let particles = strand_particles(&app, rope);
+    app.world_mut().entity_mut(particles[0]).insert(BodyAnchor {
+        body: beam,
+        offset: Vec2::new(0.0, -0.025),
+    });
+    app.world_mut()
+        .entity_mut(particles[links - 1])
+        .insert(BodyAnchor {
+            body: load,
+            offset: Vec2::new(0.0, hook as f32),
+        });
+    let reach = spacing * (links - 1) as f64 + hook + 0.03;
+    let mut beam_travel = 0.0f64;
+    for k in 0..240 {
+        let t = k as f64 * TICK;
+        app.world_mut()
+            .get_mut::<bevy_rapier2d::prelude::Velocity>(beam)
+            .unwrap()
+            .linear
+            .x = (0.35 * (0.9 * t).cos()) as f32;
+        app.update();
+        let (b, c) = (body_position(&app, beam), body_position(&app, load));
+        beam_travel = beam_travel.max(b.x);
+        assert!(
+            c.is_finite() && b.distance(c) < reach,
+            "tick {k}: the crate at {c}, the beam at {b}"
+        );
+    }
+    // The beam really moved, and the rope's top went with it.
+    assert!(beam_travel > 0.2, "the beam reached {beam_travel}");
+    let beam_at = body_position(&app, beam);
+    let top_at = position(&app, particles[0]);
+    assert!(
+        top_at.distance(beam_at + DVec2::new(0.0, -0.025)) < 0.02,
+        "the rope's top at {top_at}, the beam at {beam_at}"
+    );
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
+
+/// The rapier_world example's bridge: posts, ground and five crates dropped one after
+/// another onto the bridge; none falls through or flies off.
+#[test]
+fn crates_dropped_one_after_another_pile_on_a_bridge() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let solid = |app: &mut App, centre: Vec2, size: Vec2| {
+        app.world_mut().spawn((
+            RigidBody::Fixed,
+            Collider::cuboid(0.5 * size.x, 0.5 * size.y),
+            CollidesWithStrands::default(),
+            Transform::from_translation(centre.extend(0.0)),
+        ));
+    };
+    solid(&mut app, Vec2::new(1.2, 0.05), Vec2::new(2.4, 0.1));
+    for x in [0.27, 1.13] {
+        solid(&mut app, Vec2::new(x, 0.4), Vec2::new(0.04, 0.6));
+    }
+    let bridge = StrandBuilder::hanging(DVec2::new(0.3, 0.72), DVec2::new(1.1, 0.72), 40, 1.08)
+        .mass(0.02)
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let mut crates = Vec::new();
+    for k in 0..600 {
+        if k % 72 == 71 && crates.len() < 5 {
+            let x = [0.62, 0.8, 0.5, 0.95, 0.7][crates.len()];
+            crates.push(
+                app.world_mut()
+                    .spawn(crate_body(Vec2::splat(0.1), 40.0, Vec2::new(x, 1.25)))
+                    .id(),
+            );
+        }
+        app.update();
+        for &c in &crates {
+            let at = body_position(&app, c);
+            assert!(
+                at.is_finite() && at.y > 0.0 && at.x.abs() < 3.0,
+                "tick {k}: a crate at {at}"
+            );
+        }
+    }
+    // Every crate above the bridge's lowest point: on it, not through it.
+    let lowest = strand_particles(&app, bridge)
+        .iter()
+        .map(|&p| position(&app, p).y)
+        .fold(f64::INFINITY, f64::min);
+    for &c in &crates {
+        let at = body_position(&app, c);
+        assert!(at.y > lowest, "a crate at {at} under the bridge ({lowest})");
+    }
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
+
+/// A crate on a light rope, let go at a small angle, swings with the period of the
+/// rope and the crate together (the double pendulum of the avian test).
+#[test]
+fn a_crate_on_a_light_rope_swings_with_the_pendulums_period() {
+    let g = 9.81;
+    let mut app = app(Vec2::new(0.0, -g as f32));
+    let (links, spacing, hook, side) = (21, 0.025, 0.056, 0.1);
+    let tilt = 0.08f64;
+    let down = DVec2::new(tilt.sin(), -tilt.cos());
+    let rope = StrandBuilder::line(DVec2::new(0.0, 1.0), down, links, spacing)
+        .mass(3e-3)
+        .pin_first()
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let end = DVec2::new(0.0, 1.0) + down * spacing * (links - 1) as f64;
+    let centre = end + down * hook;
+    let load = app
+        .world_mut()
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::cuboid(0.5 * side as f32, 0.5 * side as f32),
+            ColliderMassProperties::Density(200.0),
+            CollidesWithStrands::default(),
+            Transform::from_xyz(centre.x as f32, centre.y as f32, 0.0)
+                .with_rotation(Quat::from_rotation_z(tilt as f32)),
+        ))
+        .id();
+    let last = *strand_particles(&app, rope).last().unwrap();
+    app.world_mut().entity_mut(last).insert(BodyAnchor {
+        body: load,
+        offset: Vec2::new(0.0, hook as f32),
+    });
+    let (mut crossings_at, mut previous) = (Vec::new(), 0.0);
+    for k in 0..840 {
+        app.update();
+        let x = body_position(&app, load).x;
+        if k >= 120 && previous < 0.0 && x >= 0.0 {
+            crossings_at.push((k as f64 - x / (x - previous)) * TICK);
+        }
+        previous = x;
+    }
+    assert!(crossings_at.len() >= 4, "no swing: {crossings_at:?}");
+    let n = crossings_at.len() - 1;
+    let period = (crossings_at[n] - crossings_at[0]) / n as f64;
+    let (l, d, k2) = (spacing * (links - 1) as f64, hook, side * side / 6.0);
+    let (a, b, c) = (
+        l * l * k2,
+        -g * (l * (d * d + k2) + d * l * l),
+        g * g * l * d,
+    );
+    let slow = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+    let expected = std::f64::consts::TAU / slow.sqrt();
+    assert!(
+        (period / expected - 1.0).abs() < 5e-3,
+        "{period} s against {expected} s"
+    );
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
+
+/// In a world measured in pixels (100 a metre, both engines told so), a crate hangs on
+/// a rope as in metres: gravity is Rapier's (scaled), lengths exact, the crate still.
+#[test]
+fn a_world_in_pixels_hangs_a_crate_as_one_in_metres() {
+    let unit = 100.0f32;
+    let mut app = app_in(Vec2::new(0.0, -9.81 * unit), unit);
+    let rope = StrandBuilder::line(DVec2::new(0.0, 100.0), -DVec2::Y, 21, 5.0)
+        .mass(0.01)
+        .pin_first()
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .unwrap();
+    let crate_ = app
+        .world_mut()
+        .spawn(crate_body(Vec2::splat(20.0), 0.01, Vec2::new(0.0, -12.0)))
+        .id();
+    let end = *strand_particles(&app, rope).last().unwrap();
+    app.world_mut().entity_mut(end).insert(BodyAnchor {
+        body: crate_,
+        offset: Vec2::new(0.0, 12.0),
+    });
+    app.world_mut()
+        .resource_mut::<StrandsConfig>()
+        .sleep
+        .enabled = false;
+    run(&mut app, 1.0);
+    let gravity = app.world().resource::<StrandsConfig>().gravity;
+    assert!((gravity.y + 981.0).abs() < 1e-3, "{gravity}");
+    let hung = body_position(&app, crate_);
+    run(&mut app, 1.0);
+    let moved = body_position(&app, crate_).distance(hung);
+    assert!(moved < 1e-2, "the crate moved {moved} px");
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
+    assert_eq!(crossings(&app), 0);
+}
