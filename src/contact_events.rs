@@ -111,7 +111,10 @@ fn collect_pairs(
     pairs.current.dedup();
 }
 
-fn write_messages(mut pairs: ResMut<TouchingPairs>, mut messages: MessageWriter<StrandContact>) {
+pub(crate) fn write_messages(
+    mut pairs: ResMut<TouchingPairs>,
+    mut messages: MessageWriter<StrandContact>,
+) {
     let pairs = &mut *pairs;
     // Started pairs, then ended ones, each in order.
     let (now, before) = (&pairs.current, &pairs.previous);

@@ -25,11 +25,11 @@ use avian2d::prelude::{
 use crate::bodies::shapes::shape_outline;
 pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
 use crate::bodies::{
-    BodyCouplingPlugin, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider,
-    drop_outline, outline_collider,
+    BodyCouplingPlugin, BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView,
+    MarkedCollider, drop_outline, outline_collider, spawn_state,
 };
-use crate::schedule::{StrandsSystems, StrandsTick, TickSet};
-use crate::world::config::{LengthUnit, StrandsConfig};
+use crate::schedule::{StrandsSystems, StrandsTick};
+use crate::world::config::{CollisionConfig, LengthUnit, StrandsConfig};
 
 /// Couples the strands with avian2d. Add it after [`StrandsPlugin`](crate::StrandsPlugin)
 /// and avian's `PhysicsPlugins`.
@@ -55,6 +55,7 @@ impl Plugin for StrandsAvianPlugin {
         // Every avian body is mirrored for the coupling.
         app.register_required_components::<RigidBody, BodyView>()
             .register_required_components::<RigidBody, BodyPush>()
+            .register_required_components::<RigidBody, BodyHeld>()
             // The strands start from the bodies' new state, whatever schedule drives
             // both (avian's default and the strands' are `FixedPostUpdate`).
             .configure_sets(
@@ -67,12 +68,14 @@ impl Plugin for StrandsAvianPlugin {
                     (mirror_bodies, (drop_unmarked, build_outlines).chain())
                         .chain()
                         .in_set(BodySync::Read),
-                    push_bodies.in_set(BodySync::Write),
+                    (hand_over, push_bodies).chain().in_set(BodySync::Write),
                 ),
             )
-            .add_systems(PostStartup, check_length_unit);
+            .add_systems(PostStartup, check_length_unit)
+            .add_observer(take_spawn_state);
         if self.share_gravity {
-            app.add_systems(StrandsTick, share_gravity.in_set(TickSet::Prepare));
+            // Before the bodies are followed: their hand-over reads the gravity.
+            app.add_systems(StrandsTick, share_gravity.in_set(BodySync::Read));
         }
     }
 }
@@ -99,6 +102,23 @@ fn check_length_unit(avian: Option<Res<PhysicsLengthUnit>>, ours: Option<Res<Len
              use StrandsPlugin::with_length_unit({})",
             avian.0, ours.0, avian.0
         );
+    }
+}
+
+/// A new body's state at its spawn, for the strands' first tick.
+fn take_spawn_state(
+    added: On<Add<BodyHeld>>,
+    mut bodies: Query<(
+        &Transform,
+        Option<&LinearVelocity>,
+        Option<&AngularVelocity>,
+        &mut BodyHeld,
+    )>,
+) {
+    if let Ok((transform, linear, angular, mut held)) = bodies.get_mut(added.entity) {
+        let linear = linear.map_or(Vec2::ZERO, |v| v.0);
+        let angular = angular.map_or(0.0, |w| w.0);
+        *held = spawn_state(transform, linear, angular);
     }
 }
 
@@ -162,27 +182,31 @@ fn build_outlines(
         ),
         Without<BodyOutline>,
     >,
-    bodies: Query<&BodyView>,
+    bodies: Query<(&BodyView, &BodyHeld)>,
+    config: Res<StrandsConfig>,
+    collisions: Res<CollisionConfig>,
 ) {
+    let tick = config.tick_seconds();
     for (entity, collider, marker, of, position, rotation, transform) in &colliders {
         commands.entity(entity).insert(AvianOutline);
         let outline = shape_outline(collider.shape_scaled().as_typed_shape(), marker.tolerance);
         let body_entity = of.map_or(entity, |of| of.body);
-        let body = bodies.get(body_entity).ok().map(|body| {
+        let body = bodies.get(body_entity).ok().map(|(body, held)| {
             // The collider's own pose where avian keeps one (a child collider), else
             // the body's.
             let (at, turn) = match (position, rotation) {
                 (Some(p), Some(r)) => (body.local_point(p.0), body.rotation.inverse() * planar(r)),
                 _ => (Vec2::ZERO, Rot2::IDENTITY),
             };
-            (body_entity, body, at, turn)
+            let (start, _) = body.at_tick_start(held, tick, collisions.thickness);
+            (body_entity, start, at, turn)
         });
         outline_collider(
             &mut commands,
             MarkedCollider {
                 entity,
                 outline,
-                body,
+                body: body.as_ref().map(|(e, v, at, turn)| (*e, v, *at, *turn)),
                 transform,
                 marker: *marker,
             },
@@ -205,13 +229,34 @@ fn drop_unmarked(
     }
 }
 
+/// The states the strands hand over, written into the bodies avian steps next.
+fn hand_over(
+    mut bodies: Query<(
+        &mut BodyPush,
+        &mut Position,
+        &mut Rotation,
+        &mut LinearVelocity,
+        &mut AngularVelocity,
+    )>,
+) {
+    for (mut push, mut position, mut rotation, mut linear, mut angular) in &mut bodies {
+        let Some(state) = push.state.take() else {
+            continue;
+        };
+        position.set_if_neq(Position(state.position));
+        rotation.set_if_neq(Rotation::radians(state.rotation.as_radians()));
+        linear.set_if_neq(LinearVelocity(state.linear));
+        angular.set_if_neq(AngularVelocity(state.angular));
+    }
+}
+
 /// The strands' pushes as forces over avian's next step.
 fn push_bodies(mut bodies: Query<(&mut BodyPush, Forces)>) {
     for (mut push, mut forces) in &mut bodies {
         if *push == BodyPush::default() {
             continue;
         }
-        let BodyPush { force, torque } = std::mem::take(&mut *push);
+        let BodyPush { force, torque, .. } = std::mem::take(&mut *push);
         forces.apply_force(force);
         forces.apply_torque(torque);
     }

@@ -4,24 +4,38 @@
 //! A particle attached to a dynamic body ([`BodyAnchor`]) is simulated, for the tick,
 //! as a free particle carrying a share of the body's mass: a vertex or the centre of
 //! the body's frame ([`truss`](super::truss)) its share of the frame, a lone anchor the
-//! body's effective mass along its edge on top of its own. It starts the tick where the
-//! body has it, with the body's velocity there, so gravity, the strands' constraints
-//! and contacts act on particle and body together, inside the exact projection. Every
-//! step the impulse the constraints and contacts gave it is measured (its momentum
-//! after the collision stage less after the predictor), with its moment about the
-//! body's centre of mass; at the tick's end the body's share goes to the body as a
-//! force and a torque over the engine's next step ([`BodyPush`]). A particle on a static or kinematic body
-//! is [`Kinematic`] instead: infinite mass, moving with the body.
+//! body's effective mass along its edge on top of its own. Gravity, the strands'
+//! constraints and contacts act on particle and body together, inside the exact
+//! projection.
+//!
+//! A body with a frame is handed over ([`handoff`](super::handoff)): the strands
+//! integrate it through the tick and write its state at the tick's end into the engine
+//! ([`BodyPush::state`], remembered in [`BodyHeld`]); the engine steps it from there,
+//! and what that step did besides gravity (its velocity against the one written, less
+//! gravity's share) acts on the frame through the next tick as an acceleration. Its
+//! frame starts each tick where the strands left it. Only on its first tick, or when
+//! the engine put it somewhere else (a teleport), does the frame start where the
+//! engine has the body, with its velocity.
+//!
+//! A lone anchor (on a body with no frame) starts each tick where the body has it;
+//! every step the impulse the constraints and contacts gave it is measured (its
+//! momentum after the collision stage less after the predictor), with its moment
+//! about the body's centre of mass, and at the tick's end the body's share goes to the
+//! body as a force and a torque over the engine's next step ([`BodyPush`]). A particle
+//! on a static or kinematic body is [`Kinematic`] instead: infinite mass, moving with
+//! the body.
 
-use bevy::math::DVec2;
+use bevy::math::{DVec2, Rot2};
 use bevy::prelude::*;
 
 use super::anchor::BodyAnchor;
+use super::handoff::{BodyState, frame_state};
 use super::shapes::effective_mass;
-use super::truss::{OutlineVertex, Rigged};
-use super::view::{BodyPush, BodyView};
+use super::truss::{BodyTruss, OutlineVertex, Rigged};
+use super::view::{BodyHeld, BodyPush, BodyView};
+use crate::contact_events::TouchingPairs;
 use crate::world::config::{CollisionConfig, StrandsConfig};
-use crate::world::particle::{Kinematic, Position, SolverIndex, Velocity};
+use crate::world::particle::{Kinematic, Particle, Position, SolverIndex, Velocity};
 use crate::world::problems::InputProblems;
 use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::strand::{Strand, StrandOf};
@@ -46,6 +60,32 @@ struct Coupled {
     impulse: DVec2,
     /// Its angular impulse about the body's centre of mass so far this tick.
     angular: f64,
+    /// Its point in the body's frame.
+    offset: Vec2,
+    /// Whether it is the frame's centre.
+    hub: bool,
+    /// Whether it is a body's one lone anchor, carrying the body's whole mass: the body
+    /// is handed over through it.
+    handover: bool,
+}
+
+/// A body the strands integrate this tick, and what its engine's last step did to it
+/// besides gravity.
+#[derive(Clone, Copy, Debug)]
+struct HeldFrame {
+    body: Entity,
+    /// The acceleration of its centre of mass.
+    linear: DVec2,
+    /// Its angular acceleration.
+    angular: f64,
+    /// Its centre of mass at the tick's start.
+    centre: DVec2,
+    /// The engine's centre of mass (in the body's frame).
+    centre_of_mass: Vec2,
+    /// The body where the tick takes it up.
+    start: BodyView,
+    /// Whether a lone anchor carries it (no frame).
+    lone: bool,
 }
 
 /// The particles coupled to dynamic bodies this tick, and their impulses.
@@ -53,6 +93,10 @@ struct Coupled {
 pub struct BodyCoupling {
     coupled: Vec<Coupled>,
     velocity_before: Vec<DVec2>,
+    /// The bodies with frames, each tick: held (`true`) or placed anew.
+    frames: Vec<(HeldFrame, bool)>,
+    /// Scratch for a frame's rigid fit.
+    fit: (Vec<DVec2>, Vec<DVec2>, Vec<f64>),
 }
 
 impl BodyCoupling {
@@ -60,6 +104,12 @@ impl BodyCoupling {
     pub fn copy_from(&mut self, other: &BodyCoupling) {
         copy_buffer(&mut self.coupled, &other.coupled);
         copy_buffer(&mut self.velocity_before, &other.velocity_before);
+        copy_buffer(&mut self.frames, &other.frames);
+    }
+
+    /// Whether the strands integrate `body` this tick (it has a frame).
+    pub fn holds(&self, body: Entity) -> bool {
+        self.frames.iter().any(|(f, _)| f.body == body)
     }
 
     /// Whether any simulated particle is coupled to a body this tick.
@@ -96,14 +146,22 @@ pub(super) fn follow_bodies(
     config: Res<StrandsConfig>,
     mut coupling: ResMut<BodyCoupling>,
     mut particles: Query<AnchorData>,
-    mut positions: ParamSet<(Query<&Position>, Query<&mut Position>)>,
+    mut positions: ParamSet<(
+        Query<&Position>,
+        Query<&mut Position>,
+        Query<(&Position, Option<&StrandOf>), With<Particle>>,
+    )>,
     strands: Query<&Strand>,
-    bodies: Query<&BodyView>,
+    bodies: Query<(&BodyView, &BodyHeld)>,
     collisions: Res<CollisionConfig>,
     mut moves: Local<Vec<(Entity, DVec2)>>,
+    mut lone_anchors: Local<Vec<(Entity, Entity, DVec2, DVec2, DVec2)>>,
     mut problems: ResMut<InputProblems>,
+    (trusses, mut near): (Query<&BodyTruss>, Local<Vec<Entity>>),
 ) {
     coupling.coupled.clear();
+    lone_anchors.clear();
+    coupling.frames.clear();
     let tick = config.tick_seconds();
     if !(tick.is_finite() && tick > 0.0) {
         return;
@@ -114,12 +172,18 @@ pub(super) fn follow_bodies(
     // back to it.
     let snap = 0.25 * collisions.thickness;
     moves.clear();
+    near_strands(
+        &mut near,
+        (&particles, &bodies, &trusses),
+        &positions.p2(),
+        (tick, collisions.thickness),
+    );
     let positions_now = positions.p0();
     for (entity, anchor, mut velocity, kinematic, vertex, rigged, strand) in &mut particles {
         let Ok(position) = positions_now.get(entity) else {
             continue;
         };
-        let Ok(body) = bodies.get(anchor.body) else {
+        let Ok((body, held)) = bodies.get(anchor.body) else {
             problems.report(
                 entity,
                 format!(
@@ -133,8 +197,37 @@ pub(super) fn follow_bodies(
         let offset = rigged.map_or(anchor.offset, |r| r.offset);
         let (point, point_velocity, arm) = body.point_motion(offset);
         let dynamic = body.is_dynamic();
+        let framed = vertex.is_some() || rigged.is_some();
+        // A frame the strands handed over last tick carries on from where they left it.
+        let handed = dynamic && framed && body.has_mass() && !near.contains(&anchor.body) && {
+            let frame = held_frame(
+                &mut coupling.frames,
+                anchor.body,
+                body,
+                held,
+                (tick, config.gravity),
+                collisions.thickness,
+            );
+            frame.is_some_and(|(_, handed)| handed)
+        };
         let off = point - position.0;
-        if dynamic && off.length() < snap {
+        let lone = dynamic && !framed && body.has_mass();
+        if lone {
+            // Placed once it is known whether it is its body's only one.
+            lone_anchors.push((entity, anchor.body, point, point_velocity, off));
+        } else if handed {
+            // Where the strands left it, moving with the body as handed over: a rigid
+            // motion, whatever the last tick's position corrections left in its
+            // velocity.
+            if rigged.is_none()
+                && let Some((frame, _)) =
+                    coupling.frames.iter().find(|(f, _)| f.body == anchor.body)
+            {
+                let arm = position.0 - frame.centre;
+                let rigid = frame.start.linear.as_dvec2() + frame.start.angular as f64 * arm.perp();
+                velocity.set_if_neq(Velocity(rigid));
+            }
+        } else if dynamic && off.length() < snap {
             moves.push((entity, point));
             velocity.set_if_neq(Velocity(point_velocity));
         } else {
@@ -177,7 +270,56 @@ pub(super) fn follow_bodies(
             arm,
             impulse: DVec2::ZERO,
             angular: 0.0,
+            offset,
+            hub: vertex.is_some_and(|v| v.centre),
+            handover: false,
         });
+    }
+    // A body's only lone anchor carries the whole body, handed over through it: it
+    // starts the tick at the hook, moving with the body's centre of mass.
+    for &(entity, body_entity, point, point_velocity, off) in lone_anchors.iter() {
+        let alone = coupling.frames.iter().all(|(f, _)| f.body != body_entity)
+            && lone_anchors.iter().filter(|l| l.1 == body_entity).count() == 1;
+        let start = alone
+            .then(|| bodies.get(body_entity).ok())
+            .flatten()
+            .and_then(|(body, held)| {
+                let (frame, handed) = held_frame(
+                    &mut coupling.frames,
+                    body_entity,
+                    body,
+                    held,
+                    (tick, config.gravity),
+                    collisions.thickness,
+                )?;
+                Some((frame, handed, body.mass as f64))
+            });
+        let Ok((_, anchor, mut velocity, ..)) = particles.get_mut(entity) else {
+            continue;
+        };
+        if let Some((mut frame, _, mass)) = start {
+            frame.lone = true;
+            if let Some(record) = coupling
+                .frames
+                .iter_mut()
+                .find(|(f, _)| f.body == body_entity)
+            {
+                record.0.lone = true;
+            }
+            let (hook, _, arm) = frame.start.point_motion(anchor.offset);
+            moves.push((entity, hook));
+            velocity.set_if_neq(Velocity(frame.start.linear.as_dvec2()));
+            if let Some(c) = coupling.coupled.iter_mut().find(|c| c.particle == entity) {
+                c.body_mass = mass;
+                c.arm = arm;
+                c.handover = true;
+            }
+        } else if off.length() < snap {
+            moves.push((entity, point));
+            velocity.set_if_neq(Velocity(point_velocity));
+        } else {
+            velocity.set_if_neq(Velocity(point_velocity + off / tick));
+        }
     }
     let mut positions_mut = positions.p1();
     for &(entity, point) in moves.iter() {
@@ -193,11 +335,101 @@ pub(super) fn follow_bodies(
         .sort_by_key(|c| (c.body, !c.replaces, c.particle));
 }
 
+/// The framed bodies not handed over this tick: those no rope is tied to (a crate
+/// that only meets strands is the engine's), and those that a strand not their own
+/// (outline, frame, a rope tied to them) is near — within their reach this tick. The
+/// contact solve's position corrections at the coupling's step put energy into a body
+/// integrated by the strands alone (a crate bounced off a rope bridge higher than it
+/// fell), so their impulses go to the engine as a force.
+fn near_strands(
+    near: &mut Vec<Entity>,
+    (anchored, bodies, trusses): (
+        &Query<AnchorData>,
+        &Query<(&BodyView, &BodyHeld)>,
+        &Query<&BodyTruss>,
+    ),
+    particles: &Query<(&Position, Option<&StrandOf>), With<Particle>>,
+    (tick, thickness): (f64, f64),
+) {
+    near.clear();
+    let mut own: Vec<(Entity, Entity)> = Vec::new();
+    let mut tied: Vec<Entity> = Vec::new();
+    for (_, anchor, _, _, _, rigged, strand) in anchored.iter() {
+        if let Some(strand) = strand {
+            own.push((anchor.body, strand.0));
+        }
+        if rigged.is_some() {
+            tied.push(anchor.body);
+        }
+    }
+    for (body_entity, _) in own.clone() {
+        if near.contains(&body_entity) {
+            continue;
+        }
+        if !tied.contains(&body_entity) {
+            near.push(body_entity);
+            continue;
+        }
+        let (Ok((body, _)), Ok(truss)) = (bodies.get(body_entity), trusses.get(body_entity)) else {
+            continue;
+        };
+        let radius = truss
+            .offsets
+            .iter()
+            .map(|&o| (o - body.centre_of_mass).length() as f64)
+            .fold(0.0, f64::max);
+        let centre = body.world_point(body.centre_of_mass).as_dvec2();
+        let reach = radius + 2.0 * body.linear.length() as f64 * tick + 3.0 * thickness;
+        let foreign = |strand: Option<&StrandOf>| {
+            strand.is_none_or(|s| !own.iter().any(|&(b, o)| b == body_entity && o == s.0))
+        };
+        if particles
+            .iter()
+            .any(|(p, strand)| foreign(strand) && (p.0 - centre).length() < reach)
+        {
+            near.push(body_entity);
+        }
+    }
+}
+
+/// The record of a framed body this tick (made for its first particle): whether the
+/// strands hand it over from the last tick (see [`BodyView::at_tick_start`]) and the
+/// acceleration the engine's step gave it besides gravity.
+fn held_frame(
+    frames: &mut Vec<(HeldFrame, bool)>,
+    entity: Entity,
+    body: &BodyView,
+    held: &BodyHeld,
+    (tick, gravity): (f64, DVec2),
+    tolerance: f64,
+) -> Option<(HeldFrame, bool)> {
+    if let Some(found) = frames.iter().find(|(f, _)| f.body == entity) {
+        return Some(*found);
+    }
+    let (start, handed) = body.at_tick_start(held, tick, tolerance);
+    let mut frame = HeldFrame {
+        body: entity,
+        linear: DVec2::ZERO,
+        angular: 0.0,
+        centre: start.world_point(start.centre_of_mass).as_dvec2(),
+        centre_of_mass: body.centre_of_mass,
+        start,
+        lone: false,
+    };
+    // A sleeping body was not stepped.
+    if handed && !body.sleeping {
+        frame.linear = (body.linear - start.linear).as_dvec2() / tick - gravity;
+        frame.angular = (body.angular - start.angular) as f64 / tick;
+    }
+    frames.push((frame, handed));
+    Some((frame, handed))
+}
+
 /// Several lone anchors on one body share it: each carries its effective mass divided
 /// by their number, so that together they never ask more of the body than it has.
 fn share_among_anchors(coupled: &mut [Coupled]) {
     for k in 0..coupled.len() {
-        if coupled[k].replaces {
+        if coupled[k].replaces || coupled[k].handover {
             continue;
         }
         let body = coupled[k].body;
@@ -254,6 +486,16 @@ pub(super) fn load_body_masses(
         state.mass[i] = c.total_mass;
         state.inverse_mass[i] = 1.0 / c.total_mass;
         c.index = i as u32;
+        // What the engine did to a handed-over body acts on its frame all tick.
+        if let Some((frame, true)) = coupling.frames.iter().find(|(f, _)| f.body == c.body) {
+            // A lone anchor moves with the centre of mass; its body turns apart.
+            let turn = if frame.lone {
+                DVec2::ZERO
+            } else {
+                frame.angular * (state.position[i] - frame.centre).perp()
+            };
+            state.external_force[i] += c.total_mass * (frame.linear + turn);
+        }
     }
     coupling.velocity_before.clear();
     coupling
@@ -321,26 +563,167 @@ pub(super) fn accumulate_impulses(mut coupling: ResMut<BodyCoupling>, state: Res
     }
 }
 
-/// At the tick's end: each body's share of its particles' impulses and their moments,
-/// as a force and a torque spread over the engine's next step, which covers the same
-/// time.
-/// Spread, not at once: gravity acts on the body through that step, and a rope that
-/// holds the body up must act with it, or the body jumps up and falls back every tick.
+/// At the tick's end: each framed body's state, fitted to its frame, for the engine to
+/// step from (and remembered); for lone anchors, the body's share of their impulses and
+/// its moment, as a force and a torque spread over the engine's next step, which covers
+/// the same time. Spread, not at once: gravity acts on the body through that step, and
+/// a rope that holds the body up must act with it, or the body jumps up and falls back
+/// every tick.
 pub(super) fn push_bodies(
-    coupling: Res<BodyCoupling>,
+    mut coupling: ResMut<BodyCoupling>,
     config: Res<StrandsConfig>,
-    mut bodies: Query<&mut BodyPush>,
+    state: Res<ParticleState>,
+    mut bodies: Query<(&mut BodyPush, &mut BodyHeld)>,
+    (trusses, touching): (Query<&BodyTruss>, Res<TouchingPairs>),
 ) {
+    let coupling = &mut *coupling;
     let tick = config.tick_seconds();
+    // A frame that touched a strand this tick (one `near_strands` did not foresee)
+    // leaves it handed over, and goes to the force from the next.
+    let touched = |body: Entity| {
+        trusses.get(body).is_ok_and(|truss| {
+            let mut pairs = touching.current.iter();
+            pairs.any(|&(a, b)| a == truss.collider || b == truss.collider)
+        })
+    };
+    for k in 0..coupling.frames.len() {
+        let frame = coupling.frames[k].0;
+        let fitted = if frame.lone {
+            carried_state(&coupling.coupled, &state, frame, tick)
+        } else {
+            fit_frame(&coupling.coupled, &mut coupling.fit, &state, frame).map(|pose| {
+                let (linear, angular) =
+                    frame_motion(&coupling.coupled, frame, (tick, config.gravity));
+                BodyState {
+                    linear,
+                    angular,
+                    ..pose
+                }
+            })
+        };
+        if let Ok((mut push, mut held)) = bodies.get_mut(frame.body) {
+            push.state = fitted;
+            // One that met a strand after all goes to the engine's force from the
+            // next tick on.
+            let next = if touched(frame.body) { None } else { fitted };
+            held.set_if_neq(BodyHeld(next));
+        }
+    }
     for c in coupling.coupled.iter().filter(|c| c.index != u32::MAX) {
+        let handed = coupling.frames.iter().any(|(f, _)| f.body == c.body);
+        if !handed && let Ok((_, mut held)) = bodies.get_mut(c.body) {
+            // The engine integrates it this tick: the next hand-over starts afresh.
+            held.set_if_neq(BodyHeld(None));
+        }
+        if handed && (c.replaces || c.handover) {
+            continue;
+        }
         let share = c.body_mass / c.total_mass / tick;
         let (force, torque) = (c.impulse * share, c.angular * share);
         if !(force.is_finite() && torque.is_finite()) {
             continue;
         }
-        if let Ok(mut push) = bodies.get_mut(c.body) {
+        if let Ok((mut push, _)) = bodies.get_mut(c.body) {
             push.force += force.as_vec2();
             push.torque += torque as f32;
         }
     }
+}
+
+/// The state of a body carried by its one lone anchor: its centre of mass where the
+/// anchor took it (the hook's arm kept from the tick's start), moving as the anchor
+/// does. Its rotation is the engine's: a lone anchor carries the body's mass, not its
+/// inertia, so the strands' pull turns no body (tie the rope into a frame, with
+/// [`CollidesWithStrands`](super::CollidesWithStrands), for that).
+fn carried_state(
+    coupled: &[Coupled],
+    state: &ParticleState,
+    frame: HeldFrame,
+    tick: f64,
+) -> Option<BodyState> {
+    let c = coupled
+        .iter()
+        .find(|c| c.body == frame.body && c.handover)?;
+    let i = c.index as usize;
+    if i >= state.len() {
+        return None;
+    }
+    let start = frame.start;
+    let angular = start.angular as f64 + frame.angular * tick;
+    let swept = 0.5 * tick * (start.angular as f64 + angular);
+    let centre = state.position[i] - c.arm.as_dvec2();
+    let rotation = start.rotation * Rot2::radians(swept as f32);
+    let body = BodyState {
+        position: centre.as_vec2() - rotation * start.centre_of_mass,
+        rotation,
+        linear: state.velocity[i].as_vec2(),
+        angular: angular as f32,
+    };
+    (body.position.is_finite() && body.linear.is_finite() && body.angular.is_finite())
+        .then_some(body)
+}
+
+/// A frame's velocity at the tick's end from its start and the impulses its particles
+/// took (and gravity and the engine's acceleration): the momentum the step gave it,
+/// not what position corrections left in its particles' velocities.
+fn frame_motion(
+    coupled: &[Coupled],
+    frame: HeldFrame,
+    (tick, gravity): (f64, DVec2),
+) -> (Vec2, f32) {
+    let start = frame.start;
+    let (mut impulse, mut moment) = (DVec2::ZERO, 0.0);
+    for c in coupled
+        .iter()
+        .filter(|c| c.body == frame.body && c.replaces)
+    {
+        impulse += c.impulse;
+        moment += c.angular;
+    }
+    let (mass, inertia) = (start.mass as f64, start.inertia as f64);
+    let linear = start.linear.as_dvec2() + impulse / mass + (gravity + frame.linear) * tick;
+    let turn = if inertia.is_finite() && inertia > 0.0 {
+        moment / inertia
+    } else {
+        0.0
+    };
+    let angular = start.angular as f64 + turn + frame.angular * tick;
+    (linear.as_vec2(), angular as f32)
+}
+
+/// The rigid state of `frame`'s particles (its hub and vertices, all simulated), or
+/// `None`.
+fn fit_frame(
+    coupled: &[Coupled],
+    (x, v, m): &mut (Vec<DVec2>, Vec<DVec2>, Vec<f64>),
+    state: &ParticleState,
+    frame: HeldFrame,
+) -> Option<BodyState> {
+    x.clear();
+    v.clear();
+    m.clear();
+    let (mut hub, mut reference) = (None, None);
+    let mut farthest = 0.0;
+    for c in coupled
+        .iter()
+        .filter(|c| c.body == frame.body && c.replaces)
+    {
+        let i = c.index as usize;
+        if i >= state.len() {
+            return None;
+        }
+        if c.hub {
+            hub = Some(x.len());
+        } else {
+            let reach = (c.offset - frame.centre_of_mass).length();
+            if reach > farthest {
+                farthest = reach;
+                reference = Some((x.len(), c.offset));
+            }
+        }
+        x.push(state.position[i]);
+        v.push(state.velocity[i]);
+        m.push(state.mass[i]);
+    }
+    frame_state((x, v, m), hub?, reference?, frame.centre_of_mass)
 }

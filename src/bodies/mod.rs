@@ -16,6 +16,7 @@
 
 pub mod anchor;
 pub mod coupling;
+pub mod handoff;
 pub mod shapes;
 pub mod truss;
 pub mod view;
@@ -30,8 +31,9 @@ use crate::schedule::{CollideSet, ConstrainSet, StepSet, StrandsStep, StrandsTic
 use crate::world::particle::Kinematic;
 pub use anchor::BodyAnchor;
 pub use coupling::BodyCoupling;
+pub use handoff::BodyState;
 use truss::{OutlineVertex, spawn_truss};
-pub use view::{BodyMotion, BodyPush, BodyView};
+pub use view::{BodyHeld, BodyMotion, BodyPush, BodyView, planar_rotation, spawn_state};
 
 /// Make strands collide with this collider (avian's or Rapier's), its curves drawn
 /// within `tolerance`.
@@ -82,7 +84,10 @@ impl Plugin for BodyCouplingPlugin {
             .configure_sets(
                 StrandsTick,
                 (
+                    // Outlines and ties exist before the bodies are followed, so that a
+                    // new body's frame is coupled from its first tick.
                     BodySync::Read
+                        .before(TickSet::Prepare)
                         .before(OutlineBuild)
                         .before(TickSet::Topology),
                     BodySync::Write.after(TickSet::Writeback),
@@ -95,14 +100,18 @@ impl Plugin for BodyCouplingPlugin {
                     (drop_unmarked, truss::rig_anchors)
                         .chain()
                         .after(BodySync::Read)
+                        .before(TickSet::Prepare)
                         .before(OutlineBuild)
                         .before(TickSet::Topology),
                     coupling::follow_bodies.in_set(TickSet::Prepare),
                     coupling::load_body_masses
                         .after(TickSet::Gather)
                         .before(TickSet::Step),
+                    // Before this tick's contacts are turned into messages (and kept
+                    // as the last tick's).
                     coupling::push_bodies
                         .after(TickSet::Writeback)
+                        .before(crate::contact_events::write_messages)
                         .before(BodySync::Write),
                 ),
             )
@@ -135,7 +144,8 @@ pub(crate) struct MarkedCollider<'a> {
     pub entity: Entity,
     /// Its outline in its own frame, or why it has none.
     pub outline: Result<(Vec<Vec2>, bool), String>,
-    /// Its pose in its body's frame (origin, angle), and the body, when it has one.
+    /// Its pose in its body's frame (origin, angle), and the body where the strands'
+    /// tick takes it up ([`BodyView::at_tick_start`]), when it has one.
     pub body: Option<(Entity, &'a BodyView, Vec2, Rot2)>,
     /// Its world transform (for a collider with no body).
     pub transform: &'a GlobalTransform,

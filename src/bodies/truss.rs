@@ -15,9 +15,10 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use super::anchor::BodyAnchor;
-use super::view::BodyView;
+use super::view::{BodyHeld, BodyView};
 use crate::colliders::ColliderOf;
 use crate::model::validate::rest_lengths_of;
+use crate::world::config::{CollisionConfig, StrandsConfig};
 use crate::world::particle::{Particle, Position, Velocity};
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
 
@@ -151,7 +152,9 @@ pub(super) fn rig_anchors(
     mut commands: Commands,
     anchors: Query<(Entity, &BodyAnchor, &Position, Option<&Rigged>), Without<OutlineVertex>>,
     positions: Query<&Position>,
-    trusses: Query<(&BodyTruss, &BodyView)>,
+    trusses: Query<(&BodyTruss, &BodyView, &BodyHeld)>,
+    config: Res<StrandsConfig>,
+    collisions: Res<CollisionConfig>,
     strands: Query<(), With<Strand>>,
 ) {
     for (particle, anchor, position, rigged) in &anchors {
@@ -161,9 +164,11 @@ pub(super) fn rig_anchors(
             }
             commands.entity(particle).remove::<Rigged>();
         }
-        let Ok((truss, body)) = trusses.get(anchor.body) else {
+        let Ok((truss, body, held)) = trusses.get(anchor.body) else {
             continue;
         };
+        // Where the frame is: where the strands will take the body up.
+        let (body, _) = body.at_tick_start(held, config.tick_seconds(), collisions.thickness);
         // Tied where it is (a tick's motion off its anchor point at most), so that the
         // ties start at their length; it is held there on the body from now on.
         let at = position.0;

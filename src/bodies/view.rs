@@ -7,6 +7,8 @@
 use bevy::math::{DVec2, Rot2};
 use bevy::prelude::*;
 
+use super::handoff::BodyState;
+
 /// How a body moves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
 pub enum BodyMotion {
@@ -85,21 +87,69 @@ impl BodyView {
         (point.as_dvec2(), velocity.as_dvec2(), arm)
     }
 
+    /// The body where the strands' tick takes it up: as the strands (or its spawn) last
+    /// handed it to the engine, when the engine has only stepped it since — its centre
+    /// of mass within `tolerance` of where that state and the engine's velocity take it
+    /// over `tick` — with whether it was; else where the engine has it.
+    pub fn at_tick_start(&self, held: &BodyHeld, tick: f64, tolerance: f64) -> (BodyView, bool) {
+        let Some(h) = held.0 else {
+            return (*self, false);
+        };
+        let centre = self.world_point(self.centre_of_mass).as_dvec2();
+        let held_centre = (h.position + h.rotation * self.centre_of_mass).as_dvec2();
+        let expected = held_centre + 0.5 * tick * (h.linear + self.linear).as_dvec2();
+        if !((centre - expected).length() <= tolerance) {
+            return (*self, false);
+        }
+        let view = BodyView {
+            position: h.position,
+            rotation: h.rotation,
+            linear: h.linear,
+            angular: h.angular,
+            ..*self
+        };
+        (view, true)
+    }
+
     /// Whether the engine has given it usable mass properties.
     pub fn has_mass(&self) -> bool {
         self.mass.is_finite() && self.mass > 0.0 && self.inertia > 0.0
     }
 }
 
-/// What the strands gave a body over the last tick, as a force and a torque about its
-/// centre of mass to act through the engine's next step (which covers the same time).
-/// Written by the coupling at the tick's end, handed to the engine by its adapter.
+/// What the strands give a body at the tick's end, handed to the engine by its
+/// adapter: the state a body with a frame ends the tick in (the engine steps it from
+/// there), and a force and a torque about its centre of mass to act through the
+/// engine's next step (what lone anchors, with no frame, pulled).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct BodyPush {
+    /// The body's pose and velocity to write into the engine.
+    pub state: Option<BodyState>,
     /// The force, world frame.
     pub force: Vec2,
     /// The torque.
     pub torque: f32,
+}
+
+/// The state the strands last wrote into a body (the start of the engine's step that
+/// followed); `None` while the strands do not integrate it.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyHeld(pub Option<BodyState>);
+
+/// The angle of a rotation about the z axis.
+pub fn planar_rotation(rotation: Quat) -> Rot2 {
+    Rot2::radians(2.0 * rotation.z.atan2(rotation.w))
+}
+
+/// A body's state at its spawn, from its transform and the engine's velocity: where the
+/// strands take it up on its first tick (the engine steps it before they see it).
+pub fn spawn_state(transform: &Transform, linear: Vec2, angular: f32) -> BodyHeld {
+    BodyHeld(Some(BodyState {
+        position: transform.translation.truncate(),
+        rotation: planar_rotation(transform.rotation),
+        linear,
+        angular,
+    }))
 }
 
 #[cfg(test)]

@@ -27,11 +27,11 @@ use bevy_rapier2d::prelude::{
 use crate::bodies::shapes::shape_outline;
 pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
 use crate::bodies::{
-    BodyCouplingPlugin, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider,
-    drop_outline, outline_collider,
+    BodyCouplingPlugin, BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView,
+    MarkedCollider, drop_outline, outline_collider, planar_rotation, spawn_state,
 };
-use crate::schedule::{StrandsSystems, StrandsTick, TickSet};
-use crate::world::config::{LengthUnit, StrandsConfig};
+use crate::schedule::{StrandsSystems, StrandsTick};
+use crate::world::config::{CollisionConfig, LengthUnit, StrandsConfig};
 
 /// Couples the strands with bevy_rapier2d. Add it after
 /// [`StrandsPlugin`](crate::StrandsPlugin) and `RapierPhysicsPlugin`.
@@ -59,6 +59,7 @@ impl Plugin for StrandsRapierPlugin {
         // an ExternalForce.
         app.register_required_components::<RigidBody, BodyView>()
             .register_required_components::<RigidBody, BodyPush>()
+            .register_required_components::<RigidBody, BodyHeld>()
             .register_required_components::<RigidBody, Velocity>()
             .register_required_components::<RigidBody, ExternalForce>()
             .register_required_components::<RigidBody, PushedForce>()
@@ -70,12 +71,14 @@ impl Plugin for StrandsRapierPlugin {
                     (mirror_bodies, (drop_unmarked, build_outlines).chain())
                         .chain()
                         .in_set(BodySync::Read),
-                    push_bodies.in_set(BodySync::Write),
+                    (hand_over, push_bodies).chain().in_set(BodySync::Write),
                 ),
             )
-            .add_systems(PostStartup, check_length_unit);
+            .add_systems(PostStartup, check_length_unit)
+            .add_observer(take_spawn_state);
         if self.share_gravity {
-            app.add_systems(StrandsTick, share_gravity.in_set(TickSet::Prepare));
+            // Before the bodies are followed: their hand-over reads the gravity.
+            app.add_systems(StrandsTick, share_gravity.in_set(BodySync::Read));
         }
     }
 }
@@ -106,6 +109,17 @@ fn check_length_unit(contexts: Query<&RapierContextSimulation>, ours: Option<Res
     }
 }
 
+/// A new body's state at its spawn, for the strands' first tick.
+fn take_spawn_state(
+    added: On<Add<BodyHeld>>,
+    mut bodies: Query<(&Transform, Option<&Velocity>, &mut BodyHeld)>,
+) {
+    if let Ok((transform, velocity, mut held)) = bodies.get_mut(added.entity) {
+        let velocity = velocity.copied().unwrap_or_default();
+        *held = spawn_state(transform, velocity.linear, velocity.angular);
+    }
+}
+
 /// What the coupling mirrors of a Rapier body.
 type RapierBody = (
     &'static Transform,
@@ -116,11 +130,6 @@ type RapierBody = (
     Option<&'static Sleeping>,
     &'static mut BodyView,
 );
-
-/// The angle of a rotation about the z axis.
-fn planar_rotation(rotation: Quat) -> Rot2 {
-    Rot2::radians(2.0 * rotation.z.atan2(rotation.w))
-}
 
 /// Each Rapier body's pose, velocity and mass properties into its [`BodyView`].
 fn mirror_bodies(mut bodies: Query<RapierBody>) {
@@ -161,9 +170,12 @@ fn build_outlines(
         (Entity, &Collider, &CollidesWithStrands, &GlobalTransform),
         Without<BodyOutline>,
     >,
-    bodies: Query<&BodyView>,
+    bodies: Query<(&BodyView, &BodyHeld)>,
     parents: Query<(&ChildOf, &Transform)>,
+    config: Res<StrandsConfig>,
+    collisions: Res<CollisionConfig>,
 ) {
+    let tick = config.tick_seconds();
     for (entity, collider, marker, transform) in &colliders {
         commands.entity(entity).insert(RapierOutline);
         let outline = shape_outline(collider.raw.as_typed_shape(), marker.tolerance);
@@ -171,7 +183,8 @@ fn build_outlines(
         let (mut at, mut turn, mut on) = (Vec2::ZERO, Rot2::IDENTITY, entity);
         let mut body = None;
         for _ in 0..16 {
-            if let Ok(view) = bodies.get(on) {
+            if let Ok((view, held)) = bodies.get(on) {
+                let (view, _) = view.at_tick_start(held, tick, collisions.thickness);
                 body = Some((on, view, at, turn));
                 break;
             }
@@ -188,7 +201,7 @@ fn build_outlines(
             MarkedCollider {
                 entity,
                 outline,
-                body,
+                body: body.as_ref().map(|(e, v, at, turn)| (*e, v, *at, *turn)),
                 transform,
                 marker: *marker,
             },
@@ -218,6 +231,25 @@ pub struct PushedForce {
     pub force: Vec2,
     /// The torque.
     pub torque: f32,
+}
+
+/// The states the strands hand over, written into the bodies Rapier steps next.
+fn hand_over(mut bodies: Query<(&mut BodyPush, &mut Transform, &mut Velocity)>) {
+    for (mut push, mut transform, mut velocity) in &mut bodies {
+        let Some(state) = push.state.take() else {
+            continue;
+        };
+        let at = state.position.extend(transform.translation.z);
+        let turn = Quat::from_rotation_z(state.rotation.as_radians());
+        if transform.translation != at || transform.rotation != turn {
+            transform.translation = at;
+            transform.rotation = turn;
+        }
+        velocity.set_if_neq(Velocity {
+            linear: state.linear,
+            angular: state.angular,
+        });
+    }
 }
 
 /// The strands' pushes into each body's [`ExternalForce`] for Rapier's next step, in
