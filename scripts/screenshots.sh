@@ -22,13 +22,13 @@ if [ "$missing" = 1 ]; then
         libxkbcommon-x11-0 libxcursor1 libxi6 libx11-xcb1 xdotool imagemagick
 fi
 
-cargo build --examples --features render,avian
+cargo build --examples --features render,avian,rapier
 export VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 export VK_ICD_FILENAMES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 export WGPU_BACKEND=vulkan
 mkdir -p "$out"
 
-for example in long_strand spaghetti_factory meatball_factory furry_creature branches sandbox game physics_world; do
+for example in long_strand spaghetti_factory meatball_factory furry_creature branches sandbox game physics_world rapier_world; do
     echo "== $example"
     STRANDS_SCREENSHOT="$out/$example.png" STRANDS_SCREENSHOT_FRAME="$frames" \
         xvfb-run -a -s '-screen 0 1280x720x24' "target/debug/examples/$example" \

@@ -9,9 +9,9 @@
 //!   off.
 //!
 //! Avian works in `f32`, the strands in `f64`: values are converted at this boundary
-//! only. A tick of the strands runs after avian's step in the same schedule, starting
-//! from the bodies' new poses and velocities; the impulses it measures reach the bodies
-//! as forces over avian's next step.
+//! only. A tick of the strands runs after avian's step in the same schedule: a body
+//! the strands hand over gets its pose and velocity written back for avian's next
+//! step; the others' impulses reach them as forces over that step.
 
 use bevy::math::Rot2;
 use bevy::prelude::*;

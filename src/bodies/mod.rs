@@ -5,16 +5,21 @@
 //!   detection, impulses and fail-safe. On a dynamic body the outline is a rigid frame
 //!   carrying the body's mass and inertia ([`truss`]), and what strands push on it goes
 //!   back to the body ([`coupling`]).
+//! - A body with a rope tied to it is handed over ([`handoff`]): the strands integrate
+//!   it through each tick and write its state into the engine, so a heavy load on a
+//!   rope swings with no energy from the coupling.
 //! - A particle with a [`BodyAnchor`] hangs on a body: a crate on a rope pulls the rope
 //!   down and the rope holds it up, with every edge exact.
 //!
 //! The engine is behind a small interface: its adapter (`crate::avian`,
 //! `crate::rapier`) mirrors each body's pose, velocity and mass properties into a
 //! [`BodyView`] in [`BodySync::Read`], hands each new marked collider's outline to
-//! [`outline_collider`], and applies each [`BodyPush`] with its own force API in
+//! `outline_collider`, and applies each [`BodyPush`] with its own force API in
 //! [`BodySync::Write`]. This module imports no engine.
 
 pub mod anchor;
+mod carry;
+mod coupled;
 pub mod coupling;
 pub mod handoff;
 pub mod shapes;

@@ -98,7 +98,9 @@ impl BodyView {
         let centre = self.world_point(self.centre_of_mass).as_dvec2();
         let held_centre = (h.position + h.rotation * self.centre_of_mass).as_dvec2();
         let expected = held_centre + 0.5 * tick * (h.linear + self.linear).as_dvec2();
-        if !((centre - expected).length() <= tolerance) {
+        // Not within tolerance, NaN included.
+        let stepped = (centre - expected).length() <= tolerance;
+        if !stepped {
             return (*self, false);
         }
         let view = BodyView {

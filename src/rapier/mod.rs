@@ -9,9 +9,10 @@
 //!   [`StrandsRapierPlugin::share_gravity`] is off.
 //!
 //! Run Rapier in the fixed schedule (`RapierPhysicsPlugin::default().in_fixed_schedule()`,
-//! or `in_schedule(FixedPostUpdate)`): the strands' tick then starts from the bodies'
-//! new poses, and their pushes act over Rapier's next step as an [`ExternalForce`]
-//! (added to whatever force the game sets, and taken off again a tick later). Bodies
+//! or `in_schedule(FixedPostUpdate)`): the strands' tick then follows Rapier's step; a
+//! body the strands hand over gets its `Transform` and `Velocity` written back for
+//! Rapier's next step, the others' pushes act over it as an [`ExternalForce`] (added
+//! to whatever force the game sets, and taken off again a tick later). Bodies
 //! are read from their `Transform`, so a coupled body sits at the root of its
 //! hierarchy, as Rapier's own bodies normally do; a collider may be the body's child.
 
