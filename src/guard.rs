@@ -12,6 +12,10 @@
 //! in which stage, and [`FiniteGuard::events`] keeps the same record for code that does
 //! not read messages (the runner stops on it). Removing [`Frozen`] lets the island move
 //! again.
+//!
+//! Nonsense that is still finite is caught the same way: a constrained edge more than
+//! [`MAX_STRETCH`] off its rest length at a step's end (the solve keeps them within
+//! 1e-9) freezes its island with a [`Quantity::Stretch`] message.
 
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
@@ -35,7 +39,13 @@ pub enum Quantity {
     Velocity,
     /// The position.
     Position,
+    /// A constrained edge's relative length error (the value's `x`), at the step's end.
+    Stretch,
 }
+
+/// The relative length error of a constrained edge past which the guard freezes its
+/// island: far above anything the solve leaves (1e-9), far below a blow-up.
+pub const MAX_STRETCH: f64 = 0.01;
 
 impl Quantity {
     /// Its name in messages.
@@ -44,11 +54,13 @@ impl Quantity {
             Quantity::Force => "force",
             Quantity::Velocity => "velocity",
             Quantity::Position => "position",
+            Quantity::Stretch => "relative stretch",
         }
     }
 }
 
-/// A non-finite value caught by the guard, and what was frozen because of it.
+/// A non-finite value (or an edge stretched past [`MAX_STRETCH`]) caught by the guard,
+/// and what was frozen because of it.
 #[derive(Message, Clone, Debug, PartialEq)]
 pub struct NonFiniteState {
     /// The step it appeared in (1-based: the steps taken once this one ends).
@@ -128,6 +140,8 @@ pub(crate) fn add_guard(app: &mut App) {
             check(StepSet::Integrate, Quantity::Position)
                 .after(StepSet::Integrate)
                 .before(StepSet::Measure),
+            // After everything that reads the step's end: it holds what it freezes.
+            check_stretch.after(StepSet::Measure),
         ),
     );
     app.add_systems(
@@ -194,7 +208,7 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
     let values = match quantity {
         Quantity::Force => &state.force,
         Quantity::Velocity => &state.velocity,
-        Quantity::Position => &state.position,
+        Quantity::Position | Quantity::Stretch => &state.position,
     };
     let Some(first) = first_non_finite(values) else {
         return;
@@ -224,6 +238,79 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
         "bevy_strands: step {step}, {stage:?} stage: particle {particle} has {} {value}; \
          {} particles frozen",
         quantity.name(),
+        event.frozen_particles
+    );
+    messages.write(event.clone());
+    guard.events.push(event);
+}
+
+/// After the Measure stage (its errors measured): freeze the islands of constrained edges stretched past
+/// [`MAX_STRETCH`] (nothing to scan while the step's largest error is below it).
+fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics>) {
+    if metrics.max_rel_length_error_now <= MAX_STRETCH {
+        return;
+    }
+    let CheckParams {
+        mut guard,
+        mut state,
+        topology,
+        clock,
+        config,
+        strands,
+        mut messages,
+    } = params;
+    let (guard, state) = (&mut *guard, &mut *state);
+    let errors = &metrics.relative_length_error;
+    let stretched = |k: usize| {
+        let e = &topology.edges[k];
+        let error = errors.get(k).copied().unwrap_or(0.0);
+        // NaN counts: the finiteness checks have caught it already, or will.
+        (e.constrained && (error > MAX_STRETCH || error.is_nan())).then_some((
+            e.a as usize,
+            e.b as usize,
+            error,
+        ))
+    };
+    let mut bad: Vec<usize> = Vec::new();
+    let mut worst: Option<(usize, f64)> = None;
+    for k in 0..topology.edges.len() {
+        let Some((a, b, error)) = stretched(k) else {
+            continue;
+        };
+        if guard.is_frozen.get(a).copied().unwrap_or(true)
+            && guard.is_frozen.get(b).copied().unwrap_or(true)
+        {
+            continue;
+        }
+        bad.extend([a, b]);
+        if worst.is_none_or(|(_, w)| error > w || error.is_nan()) {
+            worst = Some((a, error));
+        }
+    }
+    let Some((first, error)) = worst else {
+        return;
+    };
+    bad.sort_unstable();
+    bad.dedup();
+    let before = guard.frozen.len();
+    freeze_islands(guard, state, &topology, &bad);
+    hold_frozen(guard, state);
+    let particle = state.entity[first];
+    let step = clock.steps;
+    let event = NonFiniteState {
+        step,
+        time: step.saturating_sub(1) as f64 * config.dt,
+        stage: StepSet::Measure,
+        particle,
+        strand: strands.get(particle).ok().map(|of| of.0),
+        quantity: Quantity::Stretch,
+        value: DVec2::new(error, 0.0),
+        bad_particles: bad.len(),
+        frozen_particles: guard.frozen.len() - before,
+    };
+    error!(
+        "bevy_strands: step {step}: an edge of particle {particle} is stretched by {error:e} \
+         of its length; {} particles frozen",
         event.frozen_particles
     );
     messages.write(event.clone());

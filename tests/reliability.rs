@@ -200,3 +200,48 @@ fn a_builder_asked_for_too_many_particles_refuses_without_building_them() {
         })
     );
 }
+
+/// A rope whose pinned end is moved a metre away, farther than the rope reaches: no
+/// solve can keep its edges, and the first step that ends with one stretched past
+/// `MAX_STRETCH` freezes its island with a message, where it was at that step's start;
+/// a rope beside it swings on untouched.
+#[test]
+fn an_edge_stretched_past_its_bound_freezes_its_island_with_a_message() {
+    let (mut app, rope, good) = two_ropes(false);
+    let last = *strand_particles(&app, rope).last().unwrap();
+    app.world_mut().entity_mut(last).insert(Pinned);
+    ticks(&mut app, 2);
+    assert!(app.world().resource::<FiniteGuard>().events.is_empty());
+    let at = position(&app, last);
+    app.world_mut()
+        .entity_mut(last)
+        .insert(Position(at + DVec2::new(1.0, 0.0)));
+    ticks(&mut app, 5);
+
+    let events = &app.world().resource::<FiniteGuard>().events;
+    assert_eq!(events.len(), 1, "{events:?}");
+    let event = &events[0];
+    assert_eq!(event.quantity, Quantity::Stretch);
+    assert_eq!(event.stage, StepSet::Measure);
+    assert_eq!(event.strand, Some(rope));
+    assert!(
+        event.value.x > bevy_strands::guard::MAX_STRETCH && event.value.x.is_finite(),
+        "{event:?}"
+    );
+    // Every particle of the rope but its two pins is frozen, and stays where it was.
+    let particles = strand_particles(&app, rope);
+    for &p in &particles[1..7] {
+        assert!(app.world().get::<Frozen>(p).is_some());
+    }
+    let held: Vec<DVec2> = particles.iter().map(|&p| position(&app, p)).collect();
+    ticks(&mut app, 3);
+    for (&p, &x) in particles.iter().zip(&held) {
+        assert_eq!(position(&app, p), x);
+    }
+    assert_eq!(app.world().resource::<FiniteGuard>().events.len(), 1);
+    // The other rope is untouched and swings.
+    for &p in &strand_particles(&app, good) {
+        assert!(app.world().get::<Frozen>(p).is_none());
+    }
+    assert!(position(&app, strand_particles(&app, good)[7]).y < 0.89);
+}
