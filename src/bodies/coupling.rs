@@ -443,7 +443,13 @@ pub(super) fn push_bodies(
         let fitted = if frame.lone {
             carried_state(&coupling.coupled, &state, frame, tick)
         } else {
+            // Away from contact the frame's own rigid motion; one that met a strand
+            // this tick leaves with the momentum its impulses gave it, without what
+            // the contact's position corrections left in its particles' velocities.
             fit_frame(&coupling.coupled, &mut coupling.fit, &state, frame).map(|pose| {
+                if !touched(frame.body) {
+                    return pose;
+                }
                 let (linear, angular) =
                     frame_motion(&coupling.coupled, frame, (tick, config.gravity));
                 BodyState {
