@@ -1,5 +1,5 @@
-//! Heavy loads on ropes, in avian2d and in bevy_rapier2d alike: a crate of 10 to 10⁵
-//! times its rope's mass let go from 30°, 60° and 90°, at a 60 Hz tick in 1, 4 and 10
+//! Heavy loads on ropes, in avian2d and in bevy_rapier2d alike: a crate of 10, 10², 10³,
+//! 10⁴ and 10⁵ times its rope's mass let go from 30°, 60° and 90°, at a 60 Hz tick in 1, 4 and 10
 //! strand substeps, with and without the crate colliding with its rope, never moves
 //! faster than its drop allows, and every edge stays exact; the 30° swing keeps the
 //! period it has at 1/3000 s; a crate spawned hanging does not fall in its first tick;
@@ -219,11 +219,15 @@ fn heavy_loads_never_outrun_their_drop<E: Engine>() {
     let mut failures = Vec::new();
     for colliding in [true, false] {
         for substeps in [1, 4, 10] {
-            for ratio in [10.0, 1e3, 1e5] {
+            for ratio in [10.0, 1e2, 1e3, 1e4, 1e5] {
                 for degrees in [30.0, 60.0, 90.0] {
                     let mut p = pendulum::<E>(ratio, degrees, substeps, colliding);
                     let mut top_speed = 0.0f64;
-                    for _ in 0..(4.0 / TICK) as usize {
+                    // The heaviest, dropped from the side at the coupling's step, for
+                    // twenty seconds; the others for four.
+                    let long = ratio == 1e5 && degrees == 90.0 && substeps == 10;
+                    let seconds = if long { 20.0 } else { 4.0 };
+                    for _ in 0..(seconds / TICK) as usize {
                         p.app.update();
                         let v = E::velocity(&p.app, p.load).length();
                         top_speed = top_speed.max(if v.is_finite() { v } else { f64::INFINITY });

@@ -40,7 +40,7 @@ pub(super) struct HeldFrame {
 /// integrated by the strands alone (a crate bounced off a rope bridge higher than it
 /// fell), so their impulses go to the engine as a force.
 pub(super) fn near_strands(
-    near: &mut Vec<Entity>,
+    (near, own): (&mut Vec<Entity>, &mut Vec<(Entity, Entity)>),
     (anchored, bodies, trusses): (
         &Query<AnchorData>,
         &Query<(&BodyView, &BodyHeld)>,
@@ -50,7 +50,7 @@ pub(super) fn near_strands(
     (tick, thickness): (f64, f64),
 ) {
     near.clear();
-    let mut own: Vec<(Entity, Entity)> = Vec::new();
+    own.clear();
     let mut tied: Vec<Entity> = Vec::new();
     for (_, anchor, _, _, _, rigged, strand) in anchored.iter() {
         if let Some(strand) = strand {
@@ -60,7 +60,8 @@ pub(super) fn near_strands(
             tied.push(anchor.body);
         }
     }
-    for (body_entity, _) in own.clone() {
+    for k in 0..own.len() {
+        let body_entity = own[k].0;
         if near.contains(&body_entity) {
             continue;
         }

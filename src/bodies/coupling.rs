@@ -48,6 +48,9 @@ pub struct BodyCoupling {
     velocity_before: Vec<DVec2>,
     /// The bodies with frames, each tick: held (`true`) or placed anew.
     frames: Vec<(HeldFrame, bool)>,
+    /// Each body with the strands of its own (its outline, frame and the ropes tied to
+    /// it), as (body, strand), this tick.
+    own: Vec<(Entity, Entity)>,
     /// Scratch for a frame's rigid fit.
     fit: (Vec<DVec2>, Vec<DVec2>, Vec<f64>),
 }
@@ -115,7 +118,7 @@ pub(super) fn follow_bodies(
     let snap = 0.25 * collisions.thickness;
     moves.clear();
     near_strands(
-        &mut near,
+        (&mut near, &mut coupling.own),
         (&particles, &bodies, &trusses),
         &positions.p2(),
         (tick, collisions.thickness),
@@ -432,10 +435,15 @@ pub(super) fn push_bodies(
     let tick = config.tick_seconds();
     // A frame that touched a strand this tick (one `near_strands` did not foresee)
     // leaves it handed over, and goes to the force from the next.
+    // Its own rope brushing it does not count: that rope weighs next to nothing
+    // against it.
+    let own = &coupling.own;
+    let foreign = |body: Entity, other: Entity| !own.iter().any(|&o| o == (body, other));
     let touched = |body: Entity| {
         trusses.get(body).is_ok_and(|truss| {
+            let c = truss.collider;
             let mut pairs = touching.current.iter();
-            pairs.any(|&(a, b)| a == truss.collider || b == truss.collider)
+            pairs.any(|&(a, b)| (a == c && foreign(body, b)) || (b == c && foreign(body, a)))
         })
     };
     for k in 0..coupling.frames.len() {
