@@ -438,7 +438,7 @@ pub(super) fn push_bodies(
     // Its own rope brushing it does not count: that rope weighs next to nothing
     // against it.
     let own = &coupling.own;
-    let foreign = |body: Entity, other: Entity| !own.iter().any(|&o| o == (body, other));
+    let foreign = |body: Entity, other: Entity| !own.contains(&(body, other));
     let touched = |body: Entity| {
         trusses.get(body).is_ok_and(|truss| {
             let c = truss.collider;
