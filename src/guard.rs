@@ -217,15 +217,40 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
     let bad: Vec<usize> = (first..values.len())
         .filter(|&i| !values[i].is_finite())
         .collect();
-    let before = guard.frozen.len();
-    freeze_islands(guard, state, &topology, &bad);
-    hold_frozen(guard, state);
-    let particle = state.entity[first];
     // The Integrate stage has already counted the step.
     let step = clock.steps + u64::from(stage != StepSet::Integrate);
+    let context = (&*topology, &*config, &strands, &mut messages);
+    freeze_and_report(
+        guard,
+        state,
+        context,
+        &bad,
+        (step, stage, first, quantity, value),
+    );
+}
+
+/// Freeze the islands of the `bad` packed particles, and say so: the event (the step,
+/// its stage, the `first` particle, the quantity and its value) as a message, in the
+/// guard's record and in the log.
+fn freeze_and_report(
+    guard: &mut FiniteGuard,
+    state: &mut ParticleState,
+    (topology, config, strands, messages): (
+        &Topology,
+        &StrandsConfig,
+        &Query<&StrandOf>,
+        &mut MessageWriter<NonFiniteState>,
+    ),
+    bad: &[usize],
+    (step, stage, first, quantity, value): (u64, StepSet, usize, Quantity, DVec2),
+) {
+    let before = guard.frozen.len();
+    freeze_islands(guard, state, topology, bad);
+    hold_frozen(guard, state);
+    let particle = state.entity[first];
     let event = NonFiniteState {
         step,
-        time: (step - 1) as f64 * config.dt,
+        time: step.saturating_sub(1) as f64 * config.dt,
         stage,
         particle,
         strand: strands.get(particle).ok().map(|of| of.0),
@@ -244,8 +269,9 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
     guard.events.push(event);
 }
 
-/// After the Measure stage (its errors measured): freeze the islands of constrained edges stretched past
-/// [`MAX_STRETCH`] (nothing to scan while the step's largest error is below it).
+/// After the Measure stage (its errors measured): freeze the islands of constrained
+/// edges stretched past [`MAX_STRETCH`] (nothing to scan while the step's largest error
+/// is below it).
 fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics>) {
     if metrics.max_rel_length_error_now <= MAX_STRETCH {
         return;
@@ -292,29 +318,15 @@ fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics
     };
     bad.sort_unstable();
     bad.dedup();
-    let before = guard.frozen.len();
-    freeze_islands(guard, state, &topology, &bad);
-    hold_frozen(guard, state);
-    let particle = state.entity[first];
-    let step = clock.steps;
-    let event = NonFiniteState {
-        step,
-        time: step.saturating_sub(1) as f64 * config.dt,
-        stage: StepSet::Measure,
-        particle,
-        strand: strands.get(particle).ok().map(|of| of.0),
-        quantity: Quantity::Stretch,
-        value: DVec2::new(error, 0.0),
-        bad_particles: bad.len(),
-        frozen_particles: guard.frozen.len() - before,
-    };
-    error!(
-        "bevy_strands: step {step}: an edge of particle {particle} is stretched by {error:e} \
-         of its length; {} particles frozen",
-        event.frozen_particles
+    let context = (&*topology, &*config, &strands, &mut messages);
+    let event = (
+        clock.steps,
+        StepSet::Measure,
+        first,
+        Quantity::Stretch,
+        DVec2::new(error, 0.0),
     );
-    messages.write(event.clone());
-    guard.events.push(event);
+    freeze_and_report(guard, state, context, &bad, event);
 }
 
 /// Freeze the islands of the `bad` packed particles at the step's start.
