@@ -40,7 +40,11 @@ pub(super) struct HeldFrame {
 /// integrated by the strands alone (a crate bounced off a rope bridge higher than it
 /// fell), so their impulses go to the engine as a force.
 pub(super) fn near_strands(
-    (near, own): (&mut Vec<Entity>, &mut Vec<(Entity, Entity)>),
+    (near, own, tied): (
+        &mut Vec<Entity>,
+        &mut Vec<(Entity, Entity)>,
+        &mut Vec<Entity>,
+    ),
     (anchored, bodies, trusses): (
         &Query<AnchorData>,
         &Query<(&BodyView, &BodyHeld)>,
@@ -51,7 +55,7 @@ pub(super) fn near_strands(
 ) {
     near.clear();
     own.clear();
-    let mut tied: Vec<Entity> = Vec::new();
+    tied.clear();
     for (_, anchor, _, _, _, rigged, strand) in anchored.iter() {
         if let Some(strand) = strand {
             own.push((anchor.body, strand.0));
@@ -60,12 +64,14 @@ pub(super) fn near_strands(
             tied.push(anchor.body);
         }
     }
-    for k in 0..own.len() {
-        let body_entity = own[k].0;
-        if near.contains(&body_entity) {
-            continue;
-        }
-        if !tied.contains(&body_entity) {
+    // Each (body, strand) once, sorted: a body's strands side by side.
+    own.sort_unstable();
+    own.dedup();
+    tied.sort_unstable();
+    tied.dedup();
+    for strands in own.chunk_by(|a, b| a.0 == b.0) {
+        let body_entity = strands[0].0;
+        if tied.binary_search(&body_entity).is_err() {
             near.push(body_entity);
             continue;
         }
@@ -80,7 +86,7 @@ pub(super) fn near_strands(
         let centre = body.world_point(body.centre_of_mass).as_dvec2();
         let reach = radius + 2.0 * body.linear.length() as f64 * tick + 3.0 * thickness;
         let foreign = |strand: Option<&StrandOf>| {
-            strand.is_none_or(|s| !own.iter().any(|&(b, o)| b == body_entity && o == s.0))
+            strand.is_none_or(|s| strands.binary_search(&(body_entity, s.0)).is_err())
         };
         if particles
             .iter()
@@ -101,9 +107,9 @@ pub(super) fn held_frame(
     held: &BodyHeld,
     (tick, gravity): (f64, DVec2),
     tolerance: f64,
-) -> Option<(HeldFrame, bool)> {
+) -> (HeldFrame, bool) {
     if let Some(found) = frames.iter().find(|(f, _)| f.body == entity) {
-        return Some(*found);
+        return *found;
     }
     let (start, handed) = body.at_tick_start(held, tick, tolerance);
     let mut frame = HeldFrame {
@@ -121,7 +127,7 @@ pub(super) fn held_frame(
         frame.angular = (body.angular - start.angular) as f64 / tick;
     }
     frames.push((frame, handed));
-    Some((frame, handed))
+    (frame, handed)
 }
 
 /// The state of a body carried by its one lone anchor: its centre of mass where the

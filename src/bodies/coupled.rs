@@ -1,6 +1,6 @@
 //! What the coupling keeps of each particle coupled to a body this tick, and what it
-//! reads of an anchored particle: shared by the exchange ([`coupling`](super::coupling))
-//! and the hand-over ([`carry`](super::carry)).
+//! reads of an anchored particle: shared by the exchange (the coupling module) and the
+//! hand-over (the carry module), which both import it.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;

@@ -49,7 +49,7 @@ pub struct BodyCoupling {
     /// The bodies with frames, each tick: held (`true`) or placed anew.
     frames: Vec<(HeldFrame, bool)>,
     /// Each body with the strands of its own (its outline, frame and the ropes tied to
-    /// it), as (body, strand), this tick.
+    /// it), as (body, strand), this tick, sorted.
     own: Vec<(Entity, Entity)>,
     /// Scratch for a frame's rigid fit.
     fit: (Vec<DVec2>, Vec<DVec2>, Vec<f64>),
@@ -102,7 +102,7 @@ pub(super) fn follow_bodies(
     mut moves: Local<Vec<(Entity, DVec2)>>,
     mut lone_anchors: Local<Vec<(Entity, Entity, DVec2, DVec2, DVec2)>>,
     mut problems: ResMut<InputProblems>,
-    (trusses, mut near): (Query<&BodyTruss>, Local<Vec<Entity>>),
+    (trusses, mut scratch): (Query<&BodyTruss>, Local<(Vec<Entity>, Vec<Entity>)>),
 ) {
     coupling.coupled.clear();
     lone_anchors.clear();
@@ -117,8 +117,9 @@ pub(super) fn follow_bodies(
     // back to it.
     let snap = 0.25 * collisions.thickness;
     moves.clear();
+    let (near, tied) = &mut *scratch;
     near_strands(
-        (&mut near, &mut coupling.own),
+        (near, &mut coupling.own, tied),
         (&particles, &bodies, &trusses),
         &positions.p2(),
         (tick, collisions.thickness),
@@ -145,7 +146,7 @@ pub(super) fn follow_bodies(
         let framed = vertex.is_some() || rigged.is_some();
         // A frame the strands handed over last tick carries on from where they left it.
         let handed = dynamic && framed && body.has_mass() && !near.contains(&anchor.body) && {
-            let frame = held_frame(
+            let (_, handed) = held_frame(
                 &mut coupling.frames,
                 anchor.body,
                 body,
@@ -153,7 +154,7 @@ pub(super) fn follow_bodies(
                 (tick, config.gravity),
                 collisions.thickness,
             );
-            frame.is_some_and(|(_, handed)| handed)
+            handed
         };
         let off = point - position.0;
         let lone = dynamic && !framed && body.has_mass();
@@ -228,21 +229,21 @@ pub(super) fn follow_bodies(
         let start = alone
             .then(|| bodies.get(body_entity).ok())
             .flatten()
-            .and_then(|(body, held)| {
-                let (frame, handed) = held_frame(
+            .map(|(body, held)| {
+                let (frame, _) = held_frame(
                     &mut coupling.frames,
                     body_entity,
                     body,
                     held,
                     (tick, config.gravity),
                     collisions.thickness,
-                )?;
-                Some((frame, handed, body.mass as f64))
+                );
+                (frame, body.mass as f64)
             });
         let Ok((_, anchor, mut velocity, ..)) = particles.get_mut(entity) else {
             continue;
         };
-        if let Some((mut frame, _, mass)) = start {
+        if let Some((mut frame, mass)) = start {
             frame.lone = true;
             if let Some(record) = coupling
                 .frames
@@ -438,7 +439,7 @@ pub(super) fn push_bodies(
     // Its own rope brushing it does not count: that rope weighs next to nothing
     // against it.
     let own = &coupling.own;
-    let foreign = |body: Entity, other: Entity| !own.contains(&(body, other));
+    let foreign = |body: Entity, other: Entity| own.binary_search(&(body, other)).is_err();
     let touched = |body: Entity| {
         trusses.get(body).is_ok_and(|truss| {
             let c = truss.collider;
