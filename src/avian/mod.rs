@@ -25,8 +25,8 @@ use avian2d::prelude::{
 use crate::bodies::shapes::shape_outline;
 pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
 use crate::bodies::{
-    BodyCouplingPlugin, BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView,
-    MarkedCollider, drop_outline, outline_collider, spawn_state,
+    BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider, OutlinedFrom,
+    outline_collider, spawn_state,
 };
 use crate::schedule::{StrandsSystems, StrandsTick};
 use crate::world::config::{CollisionConfig, LengthUnit, StrandsConfig};
@@ -49,30 +49,20 @@ impl Default for StrandsAvianPlugin {
 
 impl Plugin for StrandsAvianPlugin {
     fn build(&self, app: &mut App) {
-        if !app.is_plugin_added::<BodyCouplingPlugin>() {
-            app.add_plugins(BodyCouplingPlugin);
-        }
-        // Every avian body is mirrored for the coupling.
-        app.register_required_components::<RigidBody, BodyView>()
-            .register_required_components::<RigidBody, BodyPush>()
-            .register_required_components::<RigidBody, BodyHeld>()
-            // The strands start from the bodies' new state, whatever schedule drives
-            // both (avian's default and the strands' are `FixedPostUpdate`).
-            .configure_sets(
-                FixedPostUpdate,
-                StrandsSystems.after(PhysicsSystems::Writeback),
-            )
-            .add_systems(
-                StrandsTick,
-                (
-                    (mirror_bodies, (drop_unmarked, build_outlines).chain())
-                        .chain()
-                        .in_set(BodySync::Read),
-                    (hand_over, push_bodies).chain().in_set(BodySync::Write),
-                ),
-            )
-            .add_systems(PostStartup, check_length_unit)
-            .add_observer(take_spawn_state);
+        crate::bodies::add_adapter::<RigidBody, Collider, _, _, _>(
+            app,
+            mirror_bodies,
+            build_outlines,
+            (hand_over, push_bodies).chain(),
+        );
+        // The strands start from the bodies' new state, whatever schedule drives
+        // both (avian's default and the strands' are `FixedPostUpdate`).
+        app.configure_sets(
+            FixedPostUpdate,
+            StrandsSystems.after(PhysicsSystems::Writeback),
+        )
+        .add_systems(PostStartup, check_length_unit)
+        .add_observer(take_spawn_state);
         if self.share_gravity {
             // Before the bodies are followed: their hand-over reads the gravity.
             app.add_systems(StrandsTick, share_gravity.in_set(BodySync::Read));
@@ -188,7 +178,9 @@ fn build_outlines(
 ) {
     let tick = config.tick_seconds();
     for (entity, collider, marker, of, position, rotation, transform) in &colliders {
-        commands.entity(entity).insert(AvianOutline);
+        commands
+            .entity(entity)
+            .insert(OutlinedFrom::<Collider>::default());
         let outline = shape_outline(collider.shape_scaled().as_typed_shape(), marker.tolerance);
         let body_entity = of.map_or(entity, |of| of.body);
         let body = bodies.get(body_entity).ok().map(|(body, held)| {
@@ -211,21 +203,6 @@ fn build_outlines(
                 marker: *marker,
             },
         );
-    }
-}
-
-/// On a collider whose outline was built from avian's shape.
-#[derive(Component, Clone, Copy, Debug, Default)]
-struct AvianOutline;
-
-/// A collider that is no longer avian's loses its outline.
-fn drop_unmarked(
-    mut commands: Commands,
-    outlined: Query<Entity, (With<AvianOutline>, Without<Collider>)>,
-) {
-    for entity in &outlined {
-        commands.entity(entity).remove::<AvianOutline>();
-        drop_outline(&mut commands, entity);
     }
 }
 

@@ -11,8 +11,8 @@
 //! - A particle with a [`BodyAnchor`] hangs on a body: a crate on a rope pulls the rope
 //!   down and the rope holds it up, with every edge exact.
 //!
-//! The engine is behind a small interface: its adapter (`crate::avian`,
-//! `crate::rapier`) mirrors each body's pose, velocity and mass properties into a
+//! The engine is behind a small interface: its adapter (the avian and rapier modules,
+//! which import this one) mirrors each body's pose, velocity and mass properties into a
 //! [`BodyView`] in [`BodySync::Read`], hands each new marked collider's outline to
 //! `outline_collider`, and applies each [`BodyPush`] with its own force API in
 //! [`BodySync::Write`]. This module imports no engine.
@@ -26,6 +26,10 @@ pub mod shapes;
 pub mod truss;
 pub mod view;
 
+use std::marker::PhantomData;
+
+use bevy::ecs::schedule::ScheduleConfigs;
+use bevy::ecs::system::ScheduleSystem;
 use bevy::prelude::*;
 
 use crate::colliders::{
@@ -136,6 +140,53 @@ impl Plugin for BodyCouplingPlugin {
                         .after(CollideSet::Account),
                 ),
             );
+    }
+}
+
+/// What every engine's adapter registers, once for `Body` (its rigid-body component)
+/// and `C` (its collider component): the engine-neutral coupling (once for all
+/// engines), the mirror components on every body, and its own systems — `mirror`
+/// (bodies into [`BodyView`]s) then `build` (new outlines, after those no longer `C`'s
+/// are dropped) before the tick, `write` (each [`BodyPush`] into the engine) after it.
+pub(crate) fn add_adapter<Body: Component, C: Component, M, B, W>(
+    app: &mut App,
+    mirror: impl IntoScheduleConfigs<ScheduleSystem, M>,
+    build: impl IntoScheduleConfigs<ScheduleSystem, B>,
+    write: impl IntoScheduleConfigs<ScheduleSystem, W>,
+) {
+    if !app.is_plugin_added::<BodyCouplingPlugin>() {
+        app.add_plugins(BodyCouplingPlugin);
+    }
+    let read: ScheduleConfigs<ScheduleSystem> = (mirror, (drop_unowned::<C>, build).chain())
+        .chain()
+        .into_configs();
+    app.register_required_components::<Body, BodyView>()
+        .register_required_components::<Body, BodyPush>()
+        .register_required_components::<Body, BodyHeld>()
+        .add_systems(
+            StrandsTick,
+            (read.in_set(BodySync::Read), write.in_set(BodySync::Write)),
+        );
+}
+
+/// On a collider whose outline was built from the engine collider `C`.
+#[derive(Component)]
+pub(crate) struct OutlinedFrom<C: Component>(PhantomData<fn() -> C>);
+
+impl<C: Component> Default for OutlinedFrom<C> {
+    fn default() -> Self {
+        Self(PhantomData)
+    }
+}
+
+/// A collider that is no longer the engine's `C` loses its outline.
+fn drop_unowned<C: Component>(
+    mut commands: Commands,
+    outlined: Query<Entity, (With<OutlinedFrom<C>>, Without<C>)>,
+) {
+    for entity in &outlined {
+        commands.entity(entity).remove::<OutlinedFrom<C>>();
+        drop_outline(&mut commands, entity);
     }
 }
 
@@ -250,7 +301,7 @@ pub(crate) fn same_length_unit(a: f64, b: f64) -> bool {
 }
 
 /// Remove a collider's outline (the outline strand goes with its StrandCollider).
-pub(crate) fn drop_outline(commands: &mut Commands, entity: Entity) {
+fn drop_outline(commands: &mut Commands, entity: Entity) {
     commands
         .entity(entity)
         .remove::<(BodyOutline, StrandCollider)>();

@@ -28,8 +28,8 @@ use bevy_rapier2d::prelude::{
 use crate::bodies::shapes::shape_outline;
 pub use crate::bodies::{BodyAnchor, BodyCoupling, CollidesWithStrands};
 use crate::bodies::{
-    BodyCouplingPlugin, BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView,
-    MarkedCollider, drop_outline, outline_collider, planar_rotation, spawn_state,
+    BodyHeld, BodyMotion, BodyOutline, BodyPush, BodySync, BodyView, MarkedCollider, OutlinedFrom,
+    outline_collider, planar_rotation, spawn_state,
 };
 use crate::schedule::{StrandsSystems, StrandsTick};
 use crate::world::config::{CollisionConfig, LengthUnit, StrandsConfig};
@@ -52,29 +52,19 @@ impl Default for StrandsRapierPlugin {
 
 impl Plugin for StrandsRapierPlugin {
     fn build(&self, app: &mut App) {
-        if !app.is_plugin_added::<BodyCouplingPlugin>() {
-            app.add_plugins(BodyCouplingPlugin);
-        }
-        // Every Rapier body is mirrored for the coupling; its velocity is written back
-        // by Rapier only where it has a Velocity, and the strands' force goes through
-        // an ExternalForce.
-        app.register_required_components::<RigidBody, BodyView>()
-            .register_required_components::<RigidBody, BodyPush>()
-            .register_required_components::<RigidBody, BodyHeld>()
-            .register_required_components::<RigidBody, Velocity>()
+        crate::bodies::add_adapter::<RigidBody, Collider, _, _, _>(
+            app,
+            mirror_bodies,
+            build_outlines,
+            (hand_over, push_bodies).chain(),
+        );
+        // Rapier writes a body's velocity back only where it has a Velocity, and the
+        // strands' force goes through an ExternalForce.
+        app.register_required_components::<RigidBody, Velocity>()
             .register_required_components::<RigidBody, ExternalForce>()
             .register_required_components::<RigidBody, PushedForce>()
             // Rapier stepped in `FixedPostUpdate` goes first too.
             .configure_sets(FixedPostUpdate, StrandsSystems.after(PhysicsSet::Writeback))
-            .add_systems(
-                StrandsTick,
-                (
-                    (mirror_bodies, (drop_unmarked, build_outlines).chain())
-                        .chain()
-                        .in_set(BodySync::Read),
-                    (hand_over, push_bodies).chain().in_set(BodySync::Write),
-                ),
-            )
             .add_systems(PostStartup, check_length_unit)
             .add_observer(take_spawn_state);
         if self.share_gravity {
@@ -178,7 +168,9 @@ fn build_outlines(
 ) {
     let tick = config.tick_seconds();
     for (entity, collider, marker, transform) in &colliders {
-        commands.entity(entity).insert(RapierOutline);
+        commands
+            .entity(entity)
+            .insert(OutlinedFrom::<Collider>::default());
         let outline = shape_outline(collider.raw.as_typed_shape(), marker.tolerance);
         // Walk up to the body, composing the collider's pose in its frame.
         let (mut at, mut turn, mut on) = (Vec2::ZERO, Rot2::IDENTITY, entity);
@@ -207,21 +199,6 @@ fn build_outlines(
                 marker: *marker,
             },
         );
-    }
-}
-
-/// On a collider whose outline was built from Rapier's shape.
-#[derive(Component, Clone, Copy, Debug, Default)]
-struct RapierOutline;
-
-/// A collider that is no longer Rapier's loses its outline.
-fn drop_unmarked(
-    mut commands: Commands,
-    outlined: Query<Entity, (With<RapierOutline>, Without<Collider>)>,
-) {
-    for entity in &outlined {
-        commands.entity(entity).remove::<RapierOutline>();
-        drop_outline(&mut commands, entity);
     }
 }
 
