@@ -95,6 +95,11 @@ pub struct Report {
     /// The largest particle speed at the end of the run: a bounded motion stays near
     /// the scene's own speeds, a step past its stability limit grows without bound.
     pub max_speed_at_end: f64,
+    /// The median speed of the free particles at the end (pinned, driven and sleeping
+    /// ones aside): a pile at rest ends below a millimetre per second.
+    pub median_speed_at_end: f64,
+    /// The 95th percentile of the same speeds.
+    pub p95_speed_at_end: f64,
     /// Step ends at which two edges sharing no particle intersected; null if unchecked.
     pub edge_crossings: Option<u64>,
     /// The first of those, with its edges; null if none (or unchecked).
@@ -206,6 +211,13 @@ impl Report {
                 format!("{:.3e}", self.max_rel_length_error_free),
             ),
             ("max_speed_at_end", format!("{:.3e}", self.max_speed_at_end)),
+            (
+                "speed_at_end",
+                format!(
+                    "median {:.3e}, 95th percentile {:.3e} (free particles)",
+                    self.median_speed_at_end, self.p95_speed_at_end
+                ),
+            ),
             ("edge_crossings", crossings),
             ("contacts", self.contacts.to_string()),
             ("collisions", self.collisions.to_string()),

@@ -505,6 +505,7 @@ fn report(
         .iter()
         .map(|p| format!("{}: {}", p.entity, p.problem))
         .collect();
+    let free_speeds = FreeSpeeds::of(world);
     Report {
         scenario: scene.name.clone(),
         config: serde_json::to_value(scene).expect("a scenario always serializes"),
@@ -523,6 +524,8 @@ fn report(
             .iter()
             .map(|v| v.length())
             .fold(0.0, f64::max),
+        median_speed_at_end: free_speeds.quantile(0.5),
+        p95_speed_at_end: free_speeds.quantile(0.95),
         edge_crossings: metrics.edge_crossings,
         first_crossing,
         contacts: metrics.contacts,
@@ -560,5 +563,37 @@ fn report(
         notes,
         input_problems,
         pictures: Vec::new(),
+    }
+}
+
+/// The speeds of the free particles at the end, sorted: every particle the solver
+/// moves, and every sleeping one (at rest, speed zero); pinned and driven ones aside.
+struct FreeSpeeds(Vec<f64>);
+
+impl FreeSpeeds {
+    fn of(world: &World) -> FreeSpeeds {
+        let asleep = world
+            .try_query_filtered::<(), With<Sleeping>>()
+            .map_or(0, |mut query| query.iter(world).count());
+        let state = world.resource::<ParticleState>();
+        let mut speeds: Vec<f64> = state
+            .velocity
+            .iter()
+            .zip(&state.inverse_mass)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(v, _)| v.length())
+            .collect();
+        speeds.resize(speeds.len() + asleep, 0.0);
+        speeds.sort_by(f64::total_cmp);
+        FreeSpeeds(speeds)
+    }
+
+    /// The speed below which a share `q` of them lie (nearest rank); 0 with none.
+    fn quantile(&self, q: f64) -> f64 {
+        if self.0.is_empty() {
+            return 0.0;
+        }
+        let rank = ((q * self.0.len() as f64).ceil() as usize).clamp(1, self.0.len());
+        self.0[rank - 1]
     }
 }
