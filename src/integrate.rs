@@ -7,8 +7,10 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::forces::implicit_angle::ImplicitAngle;
 use crate::forces::implicit_bending::ImplicitBending;
 use crate::forces::quadratic_bending::add_quadratic_bending;
+use crate::model::Bend;
 use crate::model::motion::end_of_step;
 use crate::schedule::{StepSet, StrandsStep};
 use crate::world::clock::SimulationClock;
@@ -54,6 +56,13 @@ pub struct ImplicitBendingState {
     /// Set when the system could not be factored (non-finite masses or stiffness);
     /// bending is then explicit until the topology changes.
     failed: bool,
+    /// The implicit angle model's bend system, and the topology it was planned for.
+    angle: ImplicitAngle,
+    angle_topology: Option<u64>,
+    /// Set as `failed`, for the angle model.
+    angle_failed: bool,
+    /// The predictor's velocities, restored if the angle system cannot be factored.
+    angle_scratch: Vec<DVec2>,
 }
 
 /// The Predict stage: explicit, or with implicit quadratic bending.
@@ -71,8 +80,27 @@ pub fn predict(
         inverse_mass,
         ..
     } = &mut *state;
-    if config.bending == BendingModel::Angle || topology.bends.is_empty() {
+    if config.bending != BendingModel::Quadratic || topology.bends.is_empty() {
+        let stiff = config.bending == BendingModel::Angle
+            && !topology.bends.is_empty()
+            && stiff_strands(&topology, mass, &mut implicit, config.dt);
+        if !stiff {
+            predict_velocities(velocity, force, inverse_mass, config.dt);
+            return;
+        }
+        let bends = &topology.bends;
+        implicit
+            .angle
+            .remove_damping(bends, position, velocity, force);
         predict_velocities(velocity, force, inverse_mass, config.dt);
+        correct_angle(
+            bends,
+            position,
+            velocity,
+            inverse_mass,
+            &mut implicit,
+            config.dt,
+        );
         return;
     }
     let implicit = &mut *implicit;
@@ -101,6 +129,51 @@ pub fn predict(
         implicit
             .solver
             .predict(&topology.bends, position, velocity, force, inverse_mass);
+    }
+}
+
+/// Whether the angle model has strands too stiff for the explicit predictor at `dt`
+/// (found again on every topology change).
+fn stiff_strands(
+    topology: &Topology,
+    mass: &[f64],
+    implicit: &mut ImplicitBendingState,
+    dt: f64,
+) -> bool {
+    if implicit.angle_topology != Some(topology.version) {
+        implicit.angle_topology = Some(topology.version);
+        implicit.angle_failed = false;
+        implicit.angle.reset(&topology.bends, mass);
+    }
+    !implicit.angle_failed && implicit.angle.update(&topology.bends, dt)
+}
+
+/// The implicit angle model's end-of-step stiffness and damping on the stiff strands'
+/// predicted velocities. A singular system (a non-finite mass or stiffness) leaves
+/// them as predicted, undamped, with an error; bending stays explicit until the
+/// topology changes.
+fn correct_angle(
+    bends: &[Bend],
+    position: &[DVec2],
+    velocity: &mut [DVec2],
+    inverse_mass: &[f64],
+    implicit: &mut ImplicitBendingState,
+    dt: f64,
+) {
+    implicit.angle_scratch.clear();
+    implicit.angle_scratch.extend_from_slice(velocity);
+    if let Err(pivot) = implicit
+        .angle
+        .correct(bends, position, velocity, inverse_mass, dt)
+    {
+        velocity.copy_from_slice(&implicit.angle_scratch);
+        error!(
+            "bevy_strands: the implicit angle bending system is singular at row {} (a \
+             non-finite mass or stiffness?); bending is explicit until the topology \
+             changes",
+            pivot.row
+        );
+        implicit.angle_failed = true;
     }
 }
 

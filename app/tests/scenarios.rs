@@ -260,7 +260,7 @@ fn the_bending_model_is_chosen_from_the_command_line_and_named_in_the_report() {
     };
     let message = error.to_string();
     assert!(
-        message.contains("--bending") && message.contains("angle, quadratic"),
+        message.contains("--bending") && message.contains("angle, angle-explicit, quadratic"),
         "{message}"
     );
 }

@@ -9,6 +9,7 @@
 pub mod bending;
 pub mod damping;
 pub mod gravity;
+pub mod implicit_angle;
 pub mod implicit_bending;
 pub mod plugin;
 pub mod quadratic_bending;

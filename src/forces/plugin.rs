@@ -43,8 +43,9 @@ pub fn accumulate_forces(
     gravity::add_gravity(mass, force, config.gravity);
     damping::add_mass_damping(mass, velocity, force, config.damping);
     springs::add_stretch_springs(&topology.edges, position, velocity, force);
-    // The quadratic model is integrated implicitly, in the Predict stage.
-    if config.bending == BendingModel::Angle {
+    // The quadratic model is integrated implicitly, in the Predict stage; the angle
+    // model's stiff strands are corrected there.
+    if config.bending != BendingModel::Quadratic {
         // The shares depend only on the topology and the thread count.
         let key = Some((topology.version, config.worker_threads()));
         let (cut_for, shares) = &mut *shares;

@@ -141,10 +141,14 @@ impl SleepConfig {
     serde(into = "String", try_from = "String")
 )]
 pub enum BendingModel {
-    /// `K (θ − θ̄)²` in the turning angle, integrated explicitly
-    /// ([`crate::forces::bending`]).
+    /// `K (θ − θ̄)²` in the turning angle, its force and damping taken at the end of
+    /// the step (linearly implicit: [`crate::forces::implicit_angle`]), so stiff
+    /// bending on short edges stays stable at a game's step.
     #[default]
     Angle,
+    /// The same energy integrated explicitly ([`crate::forces::bending`]): stable only
+    /// while the step is short of the stiffest bend's period over π — for studies.
+    AngleExplicit,
     /// `K |d|²` in the bend vector, a quadratic form with a constant Hessian on
     /// exact-length edges, integrated implicitly
     /// ([`crate::forces::quadratic_bending`], [`crate::forces::implicit_bending`]).
@@ -153,12 +157,17 @@ pub enum BendingModel {
 
 impl BendingModel {
     /// Every model.
-    pub const ALL: [BendingModel; 2] = [BendingModel::Angle, BendingModel::Quadratic];
+    pub const ALL: [BendingModel; 3] = [
+        BendingModel::Angle,
+        BendingModel::AngleExplicit,
+        BendingModel::Quadratic,
+    ];
 
     /// The name used on the command line and in scene files and reports.
     pub fn name(self) -> &'static str {
         match self {
             BendingModel::Angle => "angle",
+            BendingModel::AngleExplicit => "angle-explicit",
             BendingModel::Quadratic => "quadratic",
         }
     }
@@ -177,7 +186,11 @@ impl std::str::FromStr for BendingModel {
         Self::ALL
             .into_iter()
             .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown bending model '{s}'; valid models: angle, quadratic"))
+            .ok_or_else(|| {
+                format!(
+                    "unknown bending model '{s}'; valid models: angle, angle-explicit, quadratic"
+                )
+            })
     }
 }
 
