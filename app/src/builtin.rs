@@ -94,6 +94,16 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         file: "assets/scenes/sandbox.ron",
         text: include_str!("../../assets/scenes/sandbox.ron"),
     },
+    BuiltinScene {
+        name: "rope_coil_fine",
+        file: "assets/scenes/rope_coil_fine.ron",
+        text: include_str!("../../assets/scenes/rope_coil_fine.ron"),
+    },
+    BuiltinScene {
+        name: "pile_fine",
+        file: "assets/scenes/pile_fine.ron",
+        text: include_str!("../../assets/scenes/pile_fine.ron"),
+    },
 ];
 
 /// The built-in scenario called `name`.

@@ -1,0 +1,110 @@
+//! Contact at a game's step: strands whose edges are one to two and a half
+//! thicknesses long, dropped onto themselves and left alone, come to rest at 1/60 s and
+//! 1/120 s, one step a tick, with sleeping off — by their speeds, not by the clock.
+//! Explicit bending on such short edges is past its stability limit at those steps
+//! and boils; the angle model takes such strands implicitly.
+
+use bevy_strands::prelude::*;
+use bevy_strands_app::fixtures::{check_crossings, ticks};
+use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
+use bevy_strands_app::scenario::Scenario;
+
+/// The median and 95th-percentile speed of the free particles.
+fn speeds(state: &ParticleState) -> (f64, f64) {
+    let mut speeds: Vec<f64> = (state.velocity.iter().zip(&state.inverse_mass))
+        .filter(|(_, w)| **w > 0.0)
+        .map(|(v, _)| v.length())
+        .collect();
+    speeds.sort_by(f64::total_cmp);
+    let at = |q: f64| speeds[((q * speeds.len() as f64) as usize).min(speeds.len() - 1)];
+    (at(0.5), at(0.95))
+}
+
+/// Run `scenario` at `dt`, one step a tick, awake, for `seconds`: the speeds at the end
+/// and the metrics.
+fn settle(mut scenario: Scenario, dt: f64, seconds: f64) -> ((f64, f64), StrandMetrics) {
+    scenario.step.dt = dt;
+    scenario.step.substeps = 1;
+    scenario.step.sleep.enabled = false;
+    let mut app = headless_app(&scenario).unwrap();
+    check_crossings(&mut app);
+    ticks(&mut app, (seconds / dt).round() as usize);
+    let world = app.world();
+    (
+        speeds(world.resource::<ParticleState>()),
+        world.resource::<StrandMetrics>().clone(),
+    )
+}
+
+/// The built-in `rope_coil_fine` (edges 1.5 thicknesses long) with a rope of 400
+/// particles: a shorter coil, the same rope.
+fn fine_coil() -> Scenario {
+    let text = include_str!("../../assets/scenes/rope_coil_fine.ron")
+        .replace("particles: 849", "particles: 400");
+    Scenario::parse(&text, "rope_coil_fine (400)").unwrap()
+}
+
+/// The built-in `pile_fine` (edges 1.4 thicknesses long), its first 45 strands.
+fn fine_pile() -> Scenario {
+    load_scenario(&RunOptions {
+        scenario: "pile_fine".into(),
+        strands: Some(45),
+        ..Default::default()
+    })
+    .unwrap()
+}
+
+/// Exact, uncrossed, and at most 2 % of the steps halved.
+fn assert_exact(name: &str, metrics: &StrandMetrics, steps: f64) {
+    assert!(
+        metrics.max_rel_length_error < 1e-12,
+        "{name}: {:e}",
+        metrics.max_rel_length_error
+    );
+    assert_eq!(metrics.edge_crossings, Some(0), "{name}");
+    assert_eq!(metrics.failsafe_steps, 0, "{name}");
+    assert!(
+        metrics.halved_steps as f64 <= 0.02 * steps,
+        "{name}: {} of {steps} steps halved",
+        metrics.halved_steps
+    );
+}
+
+#[test]
+fn a_fine_rope_coil_comes_to_rest_at_a_games_step() {
+    // It has landed within a second; three more and it lies still.
+    for dt in [1.0 / 60.0, 1.0 / 120.0] {
+        let ((median, p95), metrics) = settle(fine_coil(), dt, 4.0);
+        let name = format!("coil at 1/{}", (1.0 / dt).round());
+        eprintln!(
+            "{name}: median {median:e}, p95 {p95:e}, halved {}",
+            metrics.halved_steps
+        );
+        assert!(median < 1e-3 && p95 < 1e-2, "{name}: {median} / {p95} m/s");
+        assert_exact(&name, &metrics, 4.0 / dt);
+    }
+}
+
+#[test]
+fn a_fine_pile_comes_to_rest_at_a_games_step() {
+    for dt in [1.0 / 60.0, 1.0 / 120.0] {
+        let ((median, p95), metrics) = settle(fine_pile(), dt, 4.0);
+        let name = format!("pile at 1/{}", (1.0 / dt).round());
+        eprintln!(
+            "{name}: median {median:e}, p95 {p95:e}, halved {}",
+            metrics.halved_steps
+        );
+        assert!(median < 1e-3 && p95 < 1e-2, "{name}: {median} / {p95} m/s");
+        assert_exact(&name, &metrics, 4.0 / dt);
+    }
+}
+
+#[test]
+fn explicit_bending_on_short_edges_boils_at_a_games_step() {
+    // The same coil with the explicit angle model: past its stability limit, the
+    // bends pump energy in and the rope never settles.
+    let mut scenario = fine_coil();
+    scenario.step.bending = BendingModel::AngleExplicit;
+    let ((median, _), _) = settle(scenario, 1.0 / 60.0, 4.0);
+    assert!(median > 1e-2, "median {median} m/s");
+}
