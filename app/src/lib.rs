@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod energy;
 pub mod export;
 pub mod fixtures;
 pub mod initial_state;

@@ -100,6 +100,17 @@ pub struct Report {
     pub median_speed_at_end: f64,
     /// The 95th percentile of the same speeds.
     pub p95_speed_at_end: f64,
+    /// The scene's mechanical energy (kinetic, gravitational, bending, springs) at the
+    /// end of the first tick, in joules.
+    pub energy_start: f64,
+    /// The same at the end of the last tick.
+    pub energy_end: f64,
+    /// The largest rise of that energy above an earlier low while nothing drove the
+    /// scene (no kinematic particle moving, no external force or tether, no particle
+    /// added or removed): energy no force put in. A scene left alone keeps it near 0.
+    pub energy_gained: f64,
+    /// Ticks in which something drove the scene (their energy starts a new low).
+    pub driven_ticks: u64,
     /// Step ends at which two edges sharing no particle intersected; null if unchecked.
     pub edge_crossings: Option<u64>,
     /// The first of those, with its edges; null if none (or unchecked).
@@ -216,6 +227,14 @@ impl Report {
                 format!(
                     "median {:.3e}, 95th percentile {:.3e} (free particles)",
                     self.median_speed_at_end, self.p95_speed_at_end
+                ),
+            ),
+            (
+                "energy",
+                format!(
+                    "{:.4e} J at the start, {:.4e} J at the end; gained {:.3e} J at most \
+                     above an earlier low with nothing driving ({} driven ticks)",
+                    self.energy_start, self.energy_end, self.energy_gained, self.driven_ticks
                 ),
             ),
             ("edge_crossings", crossings),

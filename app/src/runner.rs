@@ -14,6 +14,7 @@ use bevy_strands::metrics::LengthErrorHistory;
 use bevy_strands::prelude::*;
 
 use crate::builtin::{builtin, builtin_names};
+use crate::energy::EnergyLedger;
 use crate::export::plot::plot_length_error;
 use crate::export::{ExportError, FrameSettings, Recorder};
 use crate::report::{CrossingReport, IslandReport, Report};
@@ -296,6 +297,7 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
     let mut particle_steps = 0u64;
     // The ticks alone: drawing and writing pictures is not the simulation's cost.
     let mut wall_seconds = 0.0;
+    let mut ledger = EnergyLedger::default();
     loop {
         let steps = world.resource::<SimulationClock>().steps;
         if steps >= total_steps {
@@ -309,6 +311,7 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         if let Some(event) = world.resource::<FiniteGuard>().events.first() {
             return Err(non_finite_error(world, event));
         }
+        ledger.observe(world);
         particle_steps += world.resource::<ParticleState>().len() as u64 * substeps as u64;
         progress(world.resource::<SimulationClock>().steps as f64 / total_steps as f64);
         if let Some(recorder) = &mut recorder {
@@ -360,7 +363,12 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
         }
     }
     let simulated = world.resource::<SimulationClock>().time - start_time;
-    let mut report = report(world, &scene, wall_seconds, particle_steps, simulated);
+    let mut report = report(
+        world,
+        &scene,
+        (wall_seconds, particle_steps, simulated),
+        &ledger,
+    );
     report.notes.splice(0..0, notes);
     if let Some(recorder) = recorder {
         let frames = recorder.finish()?;
@@ -417,13 +425,15 @@ fn non_finite_error(world: &World, event: &NonFiniteState) -> RunError {
     }
 }
 
+/// The report of a run: `timing` is its wall seconds, particle-steps and simulated
+/// seconds.
 fn report(
     world: &World,
     scene: &Scenario,
-    wall_seconds: f64,
-    particle_steps: u64,
-    simulated: f64,
+    timing: (f64, u64, f64),
+    ledger: &EnergyLedger,
 ) -> Report {
+    let (wall_seconds, particle_steps, simulated) = timing;
     let metrics = world.resource::<StrandMetrics>();
     let clock = world.resource::<SimulationClock>();
     let solver = world.resource::<ConstraintConfig>().solver;
@@ -526,6 +536,10 @@ fn report(
             .fold(0.0, f64::max),
         median_speed_at_end: free_speeds.quantile(0.5),
         p95_speed_at_end: free_speeds.quantile(0.95),
+        energy_start: ledger.start.unwrap_or(ledger.end),
+        energy_end: ledger.end,
+        energy_gained: ledger.largest_rise,
+        driven_ticks: ledger.driven_ticks,
         edge_crossings: metrics.edge_crossings,
         first_crossing,
         contacts: metrics.contacts,

@@ -5,6 +5,7 @@
 //! and boils; the angle model takes such strands implicitly.
 
 use bevy_strands::prelude::*;
+use bevy_strands_app::energy::EnergyLedger;
 use bevy_strands_app::fixtures::{check_crossings, ticks};
 use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
 use bevy_strands_app::scenario::Scenario;
@@ -20,19 +21,28 @@ fn speeds(state: &ParticleState) -> (f64, f64) {
     (at(0.5), at(0.95))
 }
 
-/// Run `scenario` at `dt`, one step a tick, awake, for `seconds`: the speeds at the end
-/// and the metrics.
-fn settle(mut scenario: Scenario, dt: f64, seconds: f64) -> ((f64, f64), StrandMetrics) {
+/// Run `scenario` at `dt`, one step a tick, awake, for `seconds`: the speeds at the end,
+/// the metrics and the energy account.
+fn settle(
+    mut scenario: Scenario,
+    dt: f64,
+    seconds: f64,
+) -> ((f64, f64), StrandMetrics, EnergyLedger) {
     scenario.step.dt = dt;
     scenario.step.substeps = 1;
     scenario.step.sleep.enabled = false;
     let mut app = headless_app(&scenario).unwrap();
     check_crossings(&mut app);
-    ticks(&mut app, (seconds / dt).round() as usize);
+    let mut ledger = EnergyLedger::default();
+    for _ in 0..(seconds / dt).round() as usize {
+        ticks(&mut app, 1);
+        ledger.observe(app.world());
+    }
     let world = app.world();
     (
         speeds(world.resource::<ParticleState>()),
         world.resource::<StrandMetrics>().clone(),
+        ledger,
     )
 }
 
@@ -74,7 +84,7 @@ fn assert_exact(name: &str, metrics: &StrandMetrics, steps: f64) {
 fn a_fine_rope_coil_comes_to_rest_at_a_games_step() {
     // It has landed within a second; three more and it lies still.
     for dt in [1.0 / 60.0, 1.0 / 120.0] {
-        let ((median, p95), metrics) = settle(fine_coil(), dt, 4.0);
+        let ((median, p95), metrics, _) = settle(fine_coil(), dt, 4.0);
         let name = format!("coil at 1/{}", (1.0 / dt).round());
         eprintln!(
             "{name}: median {median:e}, p95 {p95:e}, halved {}",
@@ -88,7 +98,7 @@ fn a_fine_rope_coil_comes_to_rest_at_a_games_step() {
 #[test]
 fn a_fine_pile_comes_to_rest_at_a_games_step() {
     for dt in [1.0 / 60.0, 1.0 / 120.0] {
-        let ((median, p95), metrics) = settle(fine_pile(), dt, 4.0);
+        let ((median, p95), metrics, _) = settle(fine_pile(), dt, 4.0);
         let name = format!("pile at 1/{}", (1.0 / dt).round());
         eprintln!(
             "{name}: median {median:e}, p95 {p95:e}, halved {}",
@@ -102,9 +112,20 @@ fn a_fine_pile_comes_to_rest_at_a_games_step() {
 #[test]
 fn explicit_bending_on_short_edges_boils_at_a_games_step() {
     // The same coil with the explicit angle model: past its stability limit, the
-    // bends pump energy in and the rope never settles.
+    // bends pump energy in and the rope never settles. The energy account sees it.
+    let (.., implicit) = settle(fine_coil(), 1.0 / 60.0, 4.0);
     let mut scenario = fine_coil();
     scenario.step.bending = BendingModel::AngleExplicit;
-    let ((median, _), _) = settle(scenario, 1.0 / 60.0, 4.0);
+    let ((median, _), _, explicit) = settle(scenario, 1.0 / 60.0, 4.0);
+    eprintln!(
+        "gained: implicit {} J, explicit {} J (start {:?} J)",
+        implicit.largest_rise, explicit.largest_rise, implicit.start
+    );
     assert!(median > 1e-2, "median {median} m/s");
+    assert!(
+        explicit.largest_rise > 3.0 * implicit.largest_rise,
+        "explicit {} J, implicit {} J",
+        explicit.largest_rise,
+        implicit.largest_rise
+    );
 }

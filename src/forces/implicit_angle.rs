@@ -612,12 +612,7 @@ mod tests {
         let mut force = vec![DVec2::ZERO; position.len()];
         for _ in 0..600 {
             force.iter_mut().for_each(|f| *f = DVec2::ZERO);
-            crate::forces::bending::add_bending(
-                &bends,
-                &position,
-                &[DVec2::ZERO; 6],
-                &mut force,
-            );
+            crate::forces::bending::add_bending(&bends, &position, &[DVec2::ZERO; 6], &mut force);
             for ((v, f), w) in velocity.iter_mut().zip(&force).zip(&inverse_mass) {
                 *v += dt * w * *f;
             }

@@ -8,6 +8,7 @@
 
 pub mod bending;
 pub mod damping;
+pub mod energy;
 pub mod gravity;
 pub mod implicit_angle;
 pub mod implicit_bending;

@@ -1,0 +1,87 @@
+//! The report's energy account: the scene's mechanical energy (kinetic, gravitational,
+//! bending, springs) at the end of every tick, and the largest rise above an earlier
+//! low while nothing drove the motion — energy no force in the scene put in, which the
+//! contact solve or the integration must have.
+
+use bevy::prelude::*;
+use bevy_strands::forces::energy::{
+    angle_bending_energy, gravity_energy, kinetic_energy, spring_energy,
+};
+use bevy_strands::forces::quadratic_bending::quadratic_bending_energy;
+use bevy_strands::prelude::*;
+use bevy_strands::world::particle::SolverIndex;
+use bevy_strands::world::topology::Topology;
+
+/// What drives a tick: its energy is then not compared with the ticks before.
+fn driven(world: &World, state: &ParticleState) -> bool {
+    let kinematic_moving = (state.inverse_mass.iter().zip(&state.velocity))
+        .any(|(w, v)| *w == 0.0 && *v != bevy::math::DVec2::ZERO);
+    let pushed = state
+        .external_force
+        .iter()
+        .any(|f| *f != bevy::math::DVec2::ZERO);
+    let tethered = world
+        .try_query_filtered::<(), With<Tether>>()
+        .is_some_and(|mut q| q.iter(world).next().is_some());
+    kinematic_moving || pushed || tethered
+}
+
+/// The account, updated after every tick.
+#[derive(Clone, Debug, Default)]
+pub struct EnergyLedger {
+    /// Energy at the end of the first tick.
+    pub start: Option<f64>,
+    /// Energy at the end of the latest tick.
+    pub end: f64,
+    /// The lowest energy since the scene was last driven or changed.
+    low: Option<f64>,
+    /// The largest rise above such a low.
+    pub largest_rise: f64,
+    /// Ticks in which something drove the scene or particles came or went.
+    pub driven_ticks: u64,
+    particles: usize,
+    counted: Vec<bool>,
+}
+
+impl EnergyLedger {
+    /// Take the energy at the end of a tick.
+    pub fn observe(&mut self, world: &World) {
+        let state = world.resource::<ParticleState>();
+        let topology = world.resource::<Topology>();
+        let config = world.resource::<StrandsConfig>();
+        // Every particle the solver moves, and every sleeping one (at rest).
+        self.counted.clear();
+        self.counted
+            .extend(state.inverse_mass.iter().map(|&w| w > 0.0));
+        if let Some(mut asleep) = world.try_query_filtered::<&SolverIndex, With<Sleeping>>() {
+            for index in asleep.iter(world) {
+                if let Some(slot) = (*index).get().and_then(|i| self.counted.get_mut(i)) {
+                    *slot = true;
+                }
+            }
+        }
+        let bending = match config.bending {
+            BendingModel::Quadratic => quadratic_bending_energy(&topology.bends, &state.position),
+            _ => angle_bending_energy(&topology.bends, &state.position),
+        };
+        let energy = kinetic_energy(&state.mass, &state.velocity, &self.counted)
+            + gravity_energy(&state.mass, &state.position, &self.counted, config.gravity)
+            + bending
+            + spring_energy(&topology.edges, &state.position);
+        if !energy.is_finite() {
+            return; // the guard reports a non-finite state
+        }
+        let changed = self.start.is_some() && state.len() != self.particles;
+        self.particles = state.len();
+        self.start.get_or_insert(energy);
+        self.end = energy;
+        if changed || driven(world, state) {
+            self.driven_ticks += 1;
+            self.low = Some(energy);
+            return;
+        }
+        let low = self.low.get_or_insert(energy);
+        *low = low.min(energy);
+        self.largest_rise = self.largest_rise.max(energy - *low);
+    }
+}
