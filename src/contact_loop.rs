@@ -19,7 +19,7 @@ use crate::collision::CollisionScratch;
 use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
 use crate::constraints::Islands;
-use crate::constraints::projection::{Bodies, ContactRow, JointSettings, RowImpulse};
+use crate::constraints::projection::{Bodies, ContactRow, JointSettings, Resting, RowImpulse};
 use crate::metrics::StrandMetrics;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
@@ -78,6 +78,7 @@ fn joint_settings(
     give_way: (u32, u32),
 ) -> JointSettings {
     JointSettings {
+        resting: None,
         projection: constraints.projection(),
         sweeps: contact.sweeps,
         contact_tolerance: contact.tolerance * collisions.thickness * dt,
@@ -147,7 +148,16 @@ pub fn speculate(
     if !speculating(&collisions, &contact, &constraints) {
         return;
     }
-    let settings = joint_settings(&contact, &collisions, &constraints, step.dt, (9, 10));
+    let settings = JointSettings {
+        // Groups at rest are met closely (the sweeps' residue keeps a pile trembling).
+        resting: Some(Resting {
+            speed: step.sleep.speed,
+            fall: step.gravity * step.dt,
+            sweeps: contact.rest_sweeps,
+            tolerance: contact.rest_tolerance * collisions.thickness * step.dt,
+        }),
+        ..joint_settings(&contact, &collisions, &constraints, step.dt, (9, 10))
+    };
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let thickness = collisions.thickness;
     let reach = contact.reach.max(1.0) * thickness;

@@ -497,6 +497,14 @@ pub struct ContactConfig {
     /// exactly whatever the contacts do. It is the speed at which a resting pile may
     /// creep into its cushion between steps.
     pub tolerance: f64,
+    /// A contact group at rest — its free particles' mean speed, apart from the step's
+    /// fall under gravity, below the sleeping speed (`SleepConfig::speed`) — has its
+    /// rows met to this many thicknesses per second instead, with up to
+    /// `rest_sweeps` sweeps: at `tolerance` the sweeps leave a pile held by friction
+    /// trembling a few centimetres per second for as long as it runs.
+    pub rest_tolerance: f64,
+    /// Gauss–Seidel sweeps per Newton step of a group at rest, at most.
+    pub rest_sweeps: u32,
     /// A pair inside the cushion may stay where it is while it is at least this
     /// fraction of the thickness apart; closer, its row pushes it out to it. Asking
     /// every resting pair back to the full thickness makes a pile breathe.
@@ -524,6 +532,8 @@ impl Default for ContactConfig {
             sweeps: 16,
             max_correction: 2.0,
             tolerance: 1.0,
+            rest_tolerance: 0.01,
+            rest_sweeps: 64,
             keep: 0.5,
             reach: 2.0,
             speculative: true,
@@ -538,6 +548,13 @@ impl ContactConfig {
         at_least("sweeps", self.sweeps as usize, 1, "a re-projection")?;
         positive("max_correction", self.max_correction)?;
         positive("tolerance", self.tolerance)?;
+        positive("rest_tolerance", self.rest_tolerance)?;
+        at_least(
+            "rest_sweeps",
+            self.rest_sweeps as usize,
+            1,
+            "a re-projection at rest",
+        )?;
         within("keep", self.keep, 0.0..=1.0)?;
         non_negative("reach", self.reach)
     }

@@ -347,6 +347,7 @@ mod tests {
 
         fn settings() -> JointSettings {
             JointSettings {
+                resting: None,
                 projection: ProjectionSettings {
                     tolerance: 1e-13,
                     max_iterations: 30,

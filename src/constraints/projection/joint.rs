@@ -31,7 +31,7 @@ use super::joint_split::Members;
 use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part, measure_edges};
 use super::scratch::Factors;
 use super::settings::{
-    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR,
+    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR, Resting,
 };
 use super::view::{Bodies, IslandView};
 use super::walk::{ChainWalk, GraphWalk, Walk};
@@ -86,7 +86,17 @@ pub fn project_jointly(
         scratch,
     );
     localize_rows(rows, impulses, velocity, dt, scratch);
-    let outcome = iterate(set, islands, settings, scratch);
+    // A group at rest is met closely by the sweeps (the contact Newton meets its rows
+    // to their fixed point whatever the tolerance).
+    let resting = match settings.resting {
+        Some(rest) if at_rest(scratch, velocity, &rest) => Some(JointSettings {
+            sweeps: rest.sweeps,
+            contact_tolerance: rest.tolerance,
+            ..*settings
+        }),
+        _ => None,
+    };
+    let outcome = iterate(set, islands, settings, resting.as_ref(), scratch);
     // Apply: a part whose corrections are absurd (nearly dependent rows asking for a
     // lever's swing) keeps its velocities.
     let limit = settings.max_correction;
@@ -122,6 +132,19 @@ pub fn project_jointly(
         converged: s.met.iter().all(|&m| m),
         ..outcome
     }
+}
+
+/// Whether the group laid out in `s` rests: its free particles' mean speed, less the
+/// step's fall, below `rest.speed`.
+fn at_rest(s: &JointScratch, velocity: &[DVec2], rest: &Resting) -> bool {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (&p, &w) in s.packed.iter().zip(&s.inverse_mass) {
+        if w > 0.0 {
+            sum += (velocity[p as usize] - rest.fall).length();
+            count += 1;
+        }
+    }
+    count > 0 && sum < rest.speed * count as f64
 }
 
 /// Number the parts' particles and edges jointly, the members in the cut's order, and
@@ -278,20 +301,24 @@ fn iterate(
     set: &IslandSet,
     islands: &[u32],
     settings: &JointSettings,
+    resting: Option<&JointSettings>,
     s: &mut JointScratch,
 ) -> JointOutcome {
     let projection = &settings.projection;
     let tolerance = projection.tolerance.max(ROUND_OFF_FLOOR);
-    let contact_tolerance = settings.contact_tolerance;
     let mut outcome = JointOutcome::default();
     let mut rows_active = !s.rows.is_empty();
+    let mut settings = settings;
     if rows_active
         && settings.solver != ContactSolver::GaussSeidel
         && super::contact_newton::solve(settings, s, &mut outcome).is_some()
     {
         // The rows and edges together; then the edges' polish below, rows frozen.
         rows_active = false;
+    } else if let Some(resting) = resting {
+        settings = resting;
     }
+    let contact_tolerance = settings.contact_tolerance;
     let mut previous_violation = f64::INFINITY;
     let shortest = s
         .parts
@@ -554,6 +581,7 @@ mod tests {
 
     fn settings() -> JointSettings {
         JointSettings {
+            resting: None,
             projection: ProjectionSettings {
                 tolerance: 1e-13,
                 max_iterations: 30,

@@ -57,7 +57,7 @@ pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
 pub use settings::{
     ConstraintDirection, ContactSolver, JointOutcome, JointSettings, MAX_RESTEP_DEPTH,
-    ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
+    ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR, Resting,
 };
 pub use view::{Bodies, Chain, Graph, IslandView};
 

@@ -115,6 +115,24 @@ pub struct ProjectionOutcome {
 /// asking for less would only spin.
 pub const ROUND_OFF_FLOOR: f64 = 16.0 * f64::EPSILON;
 
+/// A group of strands at rest: its free particles' mean speed, apart from the step's
+/// fall under gravity, below `speed`. Its rows are met to `tolerance` with up to
+/// `sweeps` sweeps: the sweeps stop at the usual tolerance a thickness per second
+/// short of their rows, and in a pile held by friction that residue never dies down
+/// (docs/contact.md); a resting group's warm start is nearly exact, so meeting it
+/// closely costs little.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resting {
+    /// The mean speed below which a group rests.
+    pub speed: f64,
+    /// The velocity gravity adds in a step (`g dt`).
+    pub fall: bevy::math::DVec2,
+    /// Sweeps per Newton step, at most.
+    pub sweeps: u32,
+    /// How far (a distance per step) a normal row may fall short of its target.
+    pub tolerance: f64,
+}
+
 /// How a joint projection is asked to stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointSettings {
@@ -133,6 +151,8 @@ pub struct JointSettings {
     /// (frozen, the edges polished alone in the steps left); the cap holds them
     /// otherwise.
     pub rows_give_way: u32,
+    /// How a group at rest is met, if differently.
+    pub resting: Option<Resting>,
     /// How the rows' impulses are found.
     pub solver: ContactSolver,
 }
