@@ -61,8 +61,6 @@ pub struct ImplicitBendingState {
     angle_topology: Option<u64>,
     /// Set as `failed`, for the angle model.
     angle_failed: bool,
-    /// The predictor's velocities, restored if the angle system cannot be factored.
-    angle_scratch: Vec<DVec2>,
 }
 
 /// The Predict stage: explicit, or with implicit quadratic bending.
@@ -160,13 +158,12 @@ fn correct_angle(
     implicit: &mut ImplicitBendingState,
     dt: f64,
 ) {
-    implicit.angle_scratch.clear();
-    implicit.angle_scratch.extend_from_slice(velocity);
+    // `correct` writes the velocities only once the system is factored: on an error
+    // they are still the predictor's.
     if let Err(pivot) = implicit
         .angle
         .correct(bends, position, velocity, inverse_mass, dt)
     {
-        velocity.copy_from_slice(&implicit.angle_scratch);
         error!(
             "bevy_strands: the implicit angle bending system is singular at row {} (a \
              non-finite mass or stiffness?); bending is explicit until the topology \

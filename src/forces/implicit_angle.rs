@@ -260,7 +260,8 @@ impl ImplicitAngle {
     }
 
     /// The implicit correction: `velocity` holds `u` (the explicit predictor with the
-    /// bends' elastic force and without their damping) and leaves with `v'`. `position`
+    /// bends' elastic force and without their damping) and leaves with `v'`; on an
+    /// error (a singular system) it is left as it came. `position`
     /// is the start of the step; `bends` those the system was planned for.
     pub fn correct(
         &mut self,
