@@ -9,8 +9,9 @@ use bevy_strands::forces::energy::{
 };
 use bevy_strands::forces::quadratic_bending::quadratic_bending_energy;
 use bevy_strands::prelude::*;
-use bevy_strands::world::particle::SolverIndex;
 use bevy_strands::world::topology::Topology;
+
+use crate::free::free_particles;
 
 /// What drives a tick: its energy is then not compared with the ticks before.
 fn driven(world: &World, state: &ParticleState) -> bool {
@@ -49,17 +50,7 @@ impl EnergyLedger {
         let state = world.resource::<ParticleState>();
         let topology = world.resource::<Topology>();
         let config = world.resource::<StrandsConfig>();
-        // Every particle the solver moves, and every sleeping one (at rest).
-        self.counted.clear();
-        self.counted
-            .extend(state.inverse_mass.iter().map(|&w| w > 0.0));
-        if let Some(mut asleep) = world.try_query_filtered::<&SolverIndex, With<Sleeping>>() {
-            for index in asleep.iter(world) {
-                if let Some(slot) = (*index).get().and_then(|i| self.counted.get_mut(i)) {
-                    *slot = true;
-                }
-            }
-        }
+        free_particles(world, &mut self.counted);
         let bending = match config.bending {
             BendingModel::Quadratic => quadratic_bending_energy(&topology.bends, &state.position),
             _ => angle_bending_energy(&topology.bends, &state.position),

@@ -14,6 +14,7 @@ pub mod builtin;
 pub mod energy;
 pub mod export;
 pub mod fixtures;
+pub mod free;
 pub mod initial_state;
 pub mod report;
 pub mod runner;

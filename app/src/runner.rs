@@ -17,6 +17,7 @@ use crate::builtin::{builtin, builtin_names};
 use crate::energy::EnergyLedger;
 use crate::export::plot::plot_length_error;
 use crate::export::{ExportError, FrameSettings, Recorder};
+use crate::free::FreeSpeeds;
 use crate::report::{CrossingReport, IslandReport, Report};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::scenes::ScenesPlugin;
@@ -577,37 +578,5 @@ fn report(
         notes,
         input_problems,
         pictures: Vec::new(),
-    }
-}
-
-/// The speeds of the free particles at the end, sorted: every particle the solver
-/// moves, and every sleeping one (at rest, speed zero); pinned and driven ones aside.
-struct FreeSpeeds(Vec<f64>);
-
-impl FreeSpeeds {
-    fn of(world: &World) -> FreeSpeeds {
-        let asleep = world
-            .try_query_filtered::<(), With<Sleeping>>()
-            .map_or(0, |mut query| query.iter(world).count());
-        let state = world.resource::<ParticleState>();
-        let mut speeds: Vec<f64> = state
-            .velocity
-            .iter()
-            .zip(&state.inverse_mass)
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(v, _)| v.length())
-            .collect();
-        speeds.resize(speeds.len() + asleep, 0.0);
-        speeds.sort_by(f64::total_cmp);
-        FreeSpeeds(speeds)
-    }
-
-    /// The speed below which a share `q` of them lie (nearest rank); 0 with none.
-    fn quantile(&self, q: f64) -> f64 {
-        if self.0.is_empty() {
-            return 0.0;
-        }
-        let rank = ((q * self.0.len() as f64).ceil() as usize).clamp(1, self.0.len());
-        self.0[rank - 1]
     }
 }
