@@ -11,6 +11,22 @@ use crate::model::Bend;
 use crate::model::geometry::{turning_angle, wrap_angle};
 use crate::parallel::{run_each, split_at_cuts};
 
+/// A bend's edge vectors `x_s − x_a`, `x_b − x_s` and its turning angle's gradient
+/// `∂θ/∂(x_a, x_s, x_b)`; none where an edge has zero length.
+#[inline]
+pub fn bend_gradient(bend: &Bend, position: &[DVec2]) -> Option<([DVec2; 2], [DVec2; 3])> {
+    let (a, s, b) = (bend.a as usize, bend.s as usize, bend.b as usize);
+    let e1 = position[s] - position[a];
+    let e2 = position[b] - position[s];
+    let (l1, l2) = (e1.length_squared(), e2.length_squared());
+    if l1 == 0.0 || l2 == 0.0 {
+        return None;
+    }
+    let grad_a = e1.perp() / l1;
+    let grad_b = e2.perp() / l2;
+    Some(([e1, e2], [grad_a, -(grad_a + grad_b), grad_b]))
+}
+
 /// Add the bending force of every element.
 pub fn add_bending(bends: &[Bend], position: &[DVec2], velocity: &[DVec2], force: &mut [DVec2]) {
     add_bending_from(bends, position, velocity, force, 0);
@@ -27,16 +43,10 @@ fn add_bending_from(
 ) {
     for bend in bends {
         let (a, s, b) = (bend.a as usize, bend.s as usize, bend.b as usize);
-        let e1 = position[s] - position[a];
-        let e2 = position[b] - position[s];
-        let (l1, l2) = (e1.length_squared(), e2.length_squared());
-        if l1 == 0.0 || l2 == 0.0 {
+        let Some(([e1, e2], [grad_a, grad_s, grad_b])) = bend_gradient(bend, position) else {
             continue;
-        }
+        };
         let theta = turning_angle(e1, e2);
-        let grad_a = e1.perp() / l1;
-        let grad_b = e2.perp() / l2;
-        let grad_s = -(grad_a + grad_b);
         let rate = grad_a.dot(velocity[a]) + grad_s.dot(velocity[s]) + grad_b.dot(velocity[b]);
         let magnitude =
             -2.0 * bend.stiffness * wrap_angle(theta - bend.rest_angle) - bend.damping * rate;

@@ -37,6 +37,7 @@
 
 use bevy::math::DVec2;
 
+use super::bending::bend_gradient;
 use crate::constraints::sparse::{SparseFactor, SparsePlan};
 use crate::constraints::tridiagonal::SingularPivot;
 use crate::model::Bend;
@@ -247,7 +248,9 @@ impl ImplicitAngle {
                 continue;
             }
             let ends = [b.a as usize, b.s as usize, b.b as usize];
-            let g = gradient(b, position);
+            let Some((_, g)) = bend_gradient(b, position) else {
+                continue;
+            };
             let rate: f64 = ends
                 .iter()
                 .zip(&g)
@@ -340,30 +343,13 @@ pub fn stiffness_number(bend: &Bend, mass: &[f64]) -> (f64, f64) {
     (bend.damping * g, 2.0 * bend.stiffness * g)
 }
 
-/// `∂θ/∂(x_a, x_s, x_b)`, zero for a bend with an edge of zero length.
-fn gradient(bend: &Bend, position: &[DVec2]) -> [DVec2; 3] {
-    let (a, s, b) = (bend.a as usize, bend.s as usize, bend.b as usize);
-    let e1 = position[s] - position[a];
-    let e2 = position[b] - position[s];
-    let (l1, l2) = (e1.length_squared(), e2.length_squared());
-    if l1 == 0.0 || l2 == 0.0 {
-        return [DVec2::ZERO; 3];
-    }
-    let (ga, gb) = (e1.perp() / l1, e2.perp() / l2);
-    [ga, -(ga + gb), gb]
-}
-
 /// A bend's scaled rows `√w r` on (a, s, b) at `position` over a step `dt`: zero for a
 /// bend with an edge of zero length.
 fn bend_rows(bend: &Bend, position: &[DVec2], dt: f64) -> [[DVec2; 3]; ROWS] {
-    let (a, s, b) = (bend.a as usize, bend.s as usize, bend.b as usize);
-    let e1 = position[s] - position[a];
-    let e2 = position[b] - position[s];
-    let (l1, l2) = (e1.length_squared(), e2.length_squared());
-    if l1 == 0.0 || l2 == 0.0 {
+    let Some(([e1, e2], [ga, gs, gb])) = bend_gradient(bend, position) else {
         return [[DVec2::ZERO; 3]; ROWS];
-    }
-    let [ga, gs, gb] = gradient(bend, position);
+    };
+    let (l1, l2) = (e1.length_squared(), e2.length_squared());
     let gauss_newton = (dt * bend.damping + 2.0 * dt * dt * bend.stiffness).sqrt();
     let bent = wrap_angle(turning_angle(e1, e2) - bend.rest_angle);
     // The positive half of 2K s ∂²φ/∂e²: φ(e) = atan2(e) has ±1/|e|² along the
