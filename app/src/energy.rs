@@ -4,10 +4,7 @@
 //! contact solve or the integration must have.
 
 use bevy::prelude::*;
-use bevy_strands::forces::energy::{
-    angle_bending_energy, gravity_energy, kinetic_energy, spring_energy,
-};
-use bevy_strands::forces::quadratic_bending::quadratic_bending_energy;
+use bevy_strands::guard::energy::MechanicalEnergy;
 use bevy_strands::prelude::*;
 use bevy_strands::world::topology::Topology;
 
@@ -15,8 +12,6 @@ use crate::free::free_particles;
 
 /// What drives a tick: its energy is then not compared with the ticks before.
 fn driven(world: &World, state: &ParticleState) -> bool {
-    let kinematic_moving = (state.inverse_mass.iter().zip(&state.velocity))
-        .any(|(w, v)| *w == 0.0 && *v != bevy::math::DVec2::ZERO);
     let pushed = state
         .external_force
         .iter()
@@ -24,7 +19,7 @@ fn driven(world: &World, state: &ParticleState) -> bool {
     let tethered = world
         .try_query_filtered::<(), With<Tether>>()
         .is_some_and(|mut q| q.iter(world).next().is_some());
-    kinematic_moving || pushed || tethered
+    pushed || bevy_strands::guard::energy::driven(state, tethered)
 }
 
 /// The account, updated after every tick.
@@ -51,14 +46,14 @@ impl EnergyLedger {
         let topology = world.resource::<Topology>();
         let config = world.resource::<StrandsConfig>();
         free_particles(world, &mut self.counted);
-        let bending = match config.bending {
-            BendingModel::Quadratic => quadratic_bending_energy(&topology.bends, &state.position),
-            _ => angle_bending_energy(&topology.bends, &state.position),
-        };
-        let energy = kinetic_energy(&state.mass, &state.velocity, &self.counted)
-            + gravity_energy(&state.mass, &state.position, &self.counted, config.gravity)
-            + bending
-            + spring_energy(&topology.edges, &state.position);
+        let energy = MechanicalEnergy::of(
+            state,
+            (&topology.edges, &topology.bends),
+            config.bending,
+            config.gravity,
+            &self.counted,
+        )
+        .total();
         if !energy.is_finite() {
             return; // the guard reports a non-finite state
         }

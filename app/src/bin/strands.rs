@@ -61,8 +61,9 @@ struct RunArgs {
     /// each row's response on its whole strands, the earlier design).
     #[arg(long, value_name = "NAME")]
     contact_solver: Option<String>,
-    /// Bending model (default: the scene's): `angle` (turning angle, explicit) or
-    /// `quadratic` (isometric quadratic, implicit).
+    /// Bending model (default: the scene's): `angle` (turning angle; implicit on strands
+    /// too stiff for the step, explicit on the others), `angle-explicit` (always
+    /// explicit, for studies) or `quadratic` (isometric quadratic, implicit).
     #[arg(long, value_name = "MODEL")]
     bending: Option<String>,
     /// Cap on constraint-projection iterations (relaxation sweeps for the baselines) per

@@ -15,7 +15,11 @@
 //!
 //! Nonsense that is still finite is caught the same way: a constrained edge more than
 //! [`MAX_STRETCH`] off its rest length at a step's end (the solve keeps them within
-//! 1e-9) freezes its island with a [`Quantity::Stretch`] message.
+//! 1e-9) freezes its island with a [`Quantity::Stretch`] message, and kinetic energy no
+//! force in the scene explains (the [`energy`] check, at a tick's end) freezes the
+//! island of its fastest particle with a [`Quantity::Speed`] message.
+
+pub mod energy;
 
 use bevy::ecs::system::SystemParam;
 use bevy::math::DVec2;
@@ -41,6 +45,9 @@ pub enum Quantity {
     Position,
     /// A constrained edge's relative length error (the value's `x`), at the step's end.
     Stretch,
+    /// The velocity of the most energetic particle when the scene's kinetic energy is
+    /// more than anything in it explains, at a tick's end.
+    Speed,
 }
 
 /// The relative length error of a constrained edge past which the guard freezes its
@@ -55,6 +62,7 @@ impl Quantity {
             Quantity::Velocity => "velocity",
             Quantity::Position => "position",
             Quantity::Stretch => "relative stretch",
+            Quantity::Speed => "unexplained velocity",
         }
     }
 }
@@ -99,6 +107,8 @@ pub struct FiniteGuard {
     is_frozen: Vec<bool>,
     /// Every event, in order.
     pub events: Vec<NonFiniteState>,
+    /// The energy check's account.
+    energy: energy::EnergyAccount,
 }
 
 /// Index of the first vector with a non-finite component. Scans in blocks whose test
@@ -148,6 +158,11 @@ pub(crate) fn add_guard(app: &mut App) {
         StrandsTick,
         (
             collect_frozen.after(TickSet::Gather).before(TickSet::Step),
+            check_energy.after(TickSet::Step).before(TickSet::Writeback),
+            (|mut guard: ResMut<FiniteGuard>, state: Res<ParticleState>| {
+                guard.energy.end_tick(&state)
+            })
+            .in_set(TickSet::Writeback),
             freeze_entities.after(TickSet::Writeback),
         ),
     );
@@ -170,6 +185,7 @@ fn collect_frozen(
         }
     }
     guard.marked = guard.frozen.len();
+    guard.energy.begin_tick(&state);
 }
 
 /// Remember where the step starts.
@@ -208,7 +224,7 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
     let values = match quantity {
         Quantity::Force => &state.force,
         Quantity::Velocity => &state.velocity,
-        Quantity::Position | Quantity::Stretch => &state.position,
+        Quantity::Position | Quantity::Stretch | Quantity::Speed => &state.position,
     };
     let Some(first) = first_non_finite(values) else {
         return;
@@ -327,6 +343,66 @@ fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics
         DVec2::new(error, 0.0),
     );
     freeze_and_report(guard, state, context, &bad, event);
+}
+
+/// At a tick's end: compare the scene's energy with what its forces explain, and freeze
+/// the island of the most energetic particle if it has far more.
+fn check_energy(
+    params: CheckParams,
+    collision: Res<crate::world::config::CollisionConfig>,
+    tethers: Query<(), With<crate::world::particle::Tether>>,
+) {
+    let CheckParams {
+        mut guard,
+        mut state,
+        topology,
+        clock,
+        config,
+        strands,
+        mut messages,
+    } = params;
+    let (guard, state) = (&mut *guard, &mut *state);
+    if state.is_empty() || guard.energy.tick_start.len() != state.len() {
+        return;
+    }
+    let frozen_now = guard.frozen.len() != guard.marked;
+    let driven = frozen_now || energy::driven(state, !tethers.is_empty());
+    let account = &mut guard.energy;
+    if !account.accrue(state, driven) {
+        return;
+    }
+    let (edges, bends) = (&topology.edges[..], &topology.bends[..]);
+    let changed = account.count(state, edges, bends);
+    let (work, driven) = account.take_pending();
+    let counted = &account.counted;
+    let energy = energy::MechanicalEnergy::of(
+        state,
+        (edges, bends),
+        config.bending,
+        config.gravity,
+        counted,
+    );
+    let free_mass: f64 = (state.mass.iter().zip(counted))
+        .filter(|(_, c)| **c)
+        .map(|(m, _)| m)
+        .sum();
+    let slack = energy::slack(free_mass, config.gravity, collision.thickness, config.dt);
+    if account.settle(energy, work, slack, changed || driven) != energy::Verdict::Unexplained {
+        return;
+    }
+    let Some(first) = (0..state.len())
+        .filter(|&i| account.counted[i])
+        .max_by(|&i, &j| {
+            let e = |k: usize| state.mass[k] * state.velocity[k].length_squared();
+            e(i).total_cmp(&e(j))
+        })
+    else {
+        return;
+    };
+    let value = state.velocity[first];
+    let context = (&*topology, &*config, &strands, &mut messages);
+    let event = (clock.steps, StepSet::Measure, first, Quantity::Speed, value);
+    freeze_and_report(guard, state, context, &[first], event);
 }
 
 /// Freeze the islands of the `bad` packed particles at the step's start.
