@@ -154,7 +154,7 @@ impl StrandsPlugin {
         }
     }
 
-    /// Never tick on its own: the caller runs [`StrandsTick`](schedule::StrandsTick).
+    /// Never tick on its own: the caller runs [`StrandsTick`].
     pub fn manual() -> Self {
         Self {
             driver: None,

@@ -224,7 +224,7 @@ impl BroadPhase {
 
     /// Build the grid over every edge's swept box: positions `x`, end positions
     /// `x + d` (`None`: not moving), inflated by `margin`. With `threads` above one and
-    /// at least [`PARALLEL_BUILD`] edges, the boxes, their cells and (in a dense grid)
+    /// at least `PARALLEL_BUILD` edges, the boxes, their cells and (in a dense grid)
     /// the counting sort are shared between threads: the boxes and cells by contiguous
     /// runs of edges, the sort by bands of grid rows, each thread entering every edge's
     /// cells of its own band in edge order. The grid is the same whatever the count.

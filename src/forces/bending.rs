@@ -83,7 +83,7 @@ pub struct BendingShares {
 
 impl BendingShares {
     /// Cut `bends` (over `particles` particles) into at most `threads` shares of about
-    /// equal size; one share below [`PARALLEL_BENDS`] bends or on one thread.
+    /// equal size; one share below `PARALLEL_BENDS` bends or on one thread.
     pub fn cut(&mut self, bends: &[Bend], particles: usize, threads: usize) {
         let n = bends.len();
         let span = |bend: &Bend| {

@@ -1,5 +1,5 @@
 //! Ribbons: strands drawn as textured triangle strips. [`geometry`] is the pure kernel
-//! (points in, vertex buffers out); with the `ribbons` feature, [`plugin`] keeps a
+//! (points in, vertex buffers out); with the `ribbons` feature, `plugin` keeps a
 //! `Mesh2d` per strand on it.
 
 pub mod geometry;

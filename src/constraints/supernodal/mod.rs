@@ -378,7 +378,7 @@ impl SupernodalPlan {
 impl SupernodalFactor {
     /// Factor the matrix of `plan` with values `value` (aligned with its pattern's
     /// entries). `scale[k]` is unknown k's natural pivot size: a pivot below
-    /// [`DEPENDENT_PIVOT`] of it is dropped when `negative[k]` (an edge), and is an
+    /// `DEPENDENT_PIVOT` of it is dropped when `negative[k]` (an edge), and is an
     /// error otherwise; each pivot must have the sign `negative` gives it. With two
     /// `threads` or more, two independent runs of subtrees the plan chose are factored
     /// at once; each front's arithmetic is the same, so the factor is the same bit for
