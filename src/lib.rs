@@ -251,3 +251,8 @@ impl Plugin for StrandsCorePlugin {
         guard::add_guard(app);
     }
 }
+
+/// The README's Rust snippets, compiled and run as doc tests so they keep working.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeSnippets;
