@@ -14,6 +14,35 @@ use crate::world::problems::InputProblems;
 
 /// Attach this particle to `target`'s `GlobalTransform`, at `offset` in the target's
 /// own frame (rotated and scaled with it).
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use bevy_strands::prelude::*;
+///
+/// let mut app = App::new();
+/// app.add_plugins((MinimalPlugins, StrandsPlugin::manual()));
+/// app.finish();
+/// app.cleanup();
+/// // A crane's hook, 10 cm below the crane's origin.
+/// let at = Vec3::new(0.3, 1.0, 0.0);
+/// let crane = app
+///     .world_mut()
+///     .spawn((Transform::from_translation(at), GlobalTransform::from_translation(at)))
+///     .id();
+/// let rope = StrandBuilder::line(DVec2::new(0.3, 0.9), DVec2::NEG_Y, 8, 0.05)
+///     .spawn_in(app.world_mut())
+///     .unwrap();
+/// let hook = app.world().get::<Strand>(rope).unwrap().particles[0];
+/// app.world_mut().entity_mut(hook).insert(Anchor {
+///     target: crane,
+///     offset: Vec2::new(0.0, -0.1),
+/// });
+/// app.world_mut().run_schedule(StrandsTick);
+/// // The rope hangs from the hook instead of falling (transforms are f32).
+/// let hook_at = app.world().get::<Position>(hook).unwrap().0;
+/// assert!(hook_at.distance(DVec2::new(0.3, 0.9)) < 1e-6);
+/// ```
 #[derive(Component, Reflect, Clone, Copy, Debug, PartialEq)]
 #[reflect(Component)]
 #[require(Kinematic)]

@@ -46,6 +46,37 @@ pub enum ColliderShape {
 }
 
 /// Make strands collide with this entity's shape.
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use bevy_strands::prelude::*;
+///
+/// let mut app = App::new();
+/// app.add_plugins((MinimalPlugins, StrandsPlugin::manual()));
+/// app.finish();
+/// app.cleanup();
+/// // A post of radius 10 cm; a rope dropped across it drapes over it.
+/// app.world_mut().spawn((
+///     StrandCollider::new(ColliderShape::Circle { radius: 0.1 }),
+///     Transform::default(),
+///     GlobalTransform::default(),
+/// ));
+/// let rope = StrandBuilder::line(DVec2::new(-0.3, 0.2), DVec2::X, 13, 0.05)
+///     .spawn_in(app.world_mut())
+///     .unwrap();
+/// for _ in 0..60 {
+///     app.world_mut().run_schedule(StrandsTick);
+/// }
+/// let strand = app.world().get::<Strand>(rope).unwrap();
+/// for &p in &strand.particles {
+///     let x = app.world().get::<Position>(p).unwrap().0;
+///     assert!(x.length() >= 0.1, "inside the post at {x}");
+/// }
+/// // Its middle lies on top of the post.
+/// let middle = app.world().get::<Position>(strand.particles[6]).unwrap().0;
+/// assert!(middle.y > 0.09 && middle.y < 0.12, "{middle}");
+/// ```
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
 pub struct StrandCollider {

@@ -131,6 +131,33 @@ pub mod prelude {
 /// `Time<Fixed>` is the game's: the plugin never changes it. [`StrandsPlugin::manual`]
 /// leaves the driving to the caller (`world.run_schedule(StrandsTick)`), as headless
 /// runs and tests do; the step is then [`StrandsConfig::dt`].
+///
+/// ```
+/// use bevy::math::DVec2;
+/// use bevy::prelude::*;
+/// use bevy_strands::prelude::*;
+///
+/// // In a game: a tick each fixed update, in a world drawn 100 pixels a metre.
+/// let mut game = App::new();
+/// game.add_plugins((MinimalPlugins, StrandsPlugin::default().with_length_unit(100.0)));
+///
+/// // In a test: ticks run by hand.
+/// let mut app = App::new();
+/// app.add_plugins((MinimalPlugins, StrandsPlugin::manual()));
+/// app.finish();
+/// app.cleanup();
+/// let rope = StrandBuilder::line(DVec2::new(0.0, 1.0), DVec2::X, 10, 0.05)
+///     .pin_first()
+///     .spawn_in(app.world_mut())
+///     .unwrap();
+/// for _ in 0..20 {
+///     app.world_mut().run_schedule(StrandsTick);
+/// }
+/// // A fifth of a second on, the free end has swung down; every edge kept its length.
+/// let end = *app.world().get::<Strand>(rope).unwrap().particles.last().unwrap();
+/// assert!(app.world().get::<Position>(end).unwrap().0.y < 0.9);
+/// assert!(app.world().resource::<StrandMetrics>().max_rel_length_error < 1e-9);
+/// ```
 #[derive(Clone, Debug)]
 pub struct StrandsPlugin {
     /// The schedule that runs a tick; `None` to drive by hand.
