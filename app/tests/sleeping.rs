@@ -10,7 +10,9 @@ use bevy_strands::contact_events::TouchingPairs;
 use bevy_strands::model::geometry::segment_distance;
 use bevy_strands::prelude::*;
 use bevy_strands::sleeping::reach::quad_distance;
-use bevy_strands_app::fixtures::{check_crossings, crossings, tick, ticks};
+use bevy_strands_app::fixtures::{
+    check_crossings, crossings, position, spawn_box, tick, ticks, velocity,
+};
 use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
 
 /// The built-in pile's bottom 45 strands (675 particles), three steps of 1/300 s a
@@ -324,6 +326,64 @@ fn despawning_a_strand_wakes_the_strands_that_rested_on_it() {
     // Exactly the strands within reach of where it lay.
     assert_eq!(awake, near);
     ticks(&mut app, 100);
+    let metrics = app.world().resource::<StrandMetrics>();
+    assert!(metrics.max_rel_length_error < 1e-12);
+    assert_eq!(crossings(&app), 0);
+}
+
+/// Sleeping is never a wall: a rope pushed against a sleeping one, touching it at
+/// 3 cm/s — below the sleep speed, so nothing counts as moving towards it — wakes it by
+/// the touch and pushes it along the floor; the wake stops at what is touched.
+#[test]
+fn a_strand_creeping_against_a_sleeping_one_wakes_it_and_pushes_it() {
+    let mut app = bevy_strands_app::fixtures::checked_app();
+    spawn_box(&mut app);
+    app.world_mut().resource_mut::<CollisionConfig>().friction = 0.0;
+    let lying = |x: f64| StrandBuilder::line(DVec2::new(x, 0.006), DVec2::X, 5, 0.02);
+    let world = app.world_mut();
+    let pusher = lying(0.2).spawn_in(world).unwrap();
+    let pushed = lying(0.285).spawn_in(world).unwrap();
+    let beyond = lying(0.05).spawn_in(world).unwrap();
+    for _ in 0..300 {
+        tick(&mut app);
+        if strands_by_sleep(&mut app).1.is_empty() {
+            break;
+        }
+    }
+    assert!(
+        strands_by_sleep(&mut app).1.is_empty(),
+        "the ropes did not sleep"
+    );
+    let first = |app: &App, s: Entity| app.world().get::<Strand>(s).unwrap().particles[0];
+    let start = position(&app, first(&app, pushed));
+    for &p in &app.world().get::<Strand>(pusher).unwrap().particles.clone() {
+        app.world_mut()
+            .entity_mut(p)
+            .insert(ExternalForce(DVec2::new(0.5, 0.0)));
+    }
+    // Until the pushed rope wakes, the pusher is slower than the sleep speed.
+    let (mut fastest, mut woke) = (0.0f64, None);
+    for k in 0..200 {
+        tick(&mut app);
+        let particles = app.world().get::<Strand>(pusher).unwrap().particles.clone();
+        if woke.is_none() {
+            for p in particles {
+                fastest = fastest.max(velocity(&app, p).length());
+            }
+            if !strands_by_sleep(&mut app).0.contains(&pushed) {
+                woke = Some(k);
+            }
+        }
+    }
+    assert!(woke.is_some(), "the sleeping rope never woke");
+    assert!(fastest < 0.05, "the pusher reached {fastest} m/s first");
+    let moved = position(&app, first(&app, pushed)) - start;
+    assert!(
+        moved.x > 0.02,
+        "the sleeping rope was a wall: moved {moved}"
+    );
+    let (asleep, _) = strands_by_sleep(&mut app);
+    assert!(asleep.contains(&beyond), "a rope nothing touched was woken");
     let metrics = app.world().resource::<StrandMetrics>();
     assert!(metrics.max_rel_length_error < 1e-12);
     assert_eq!(crossings(&app), 0);

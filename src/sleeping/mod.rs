@@ -42,7 +42,7 @@ use crate::world::particle::{
 use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::Topology;
 use reach::{ReachInput, ReachScratch, find_reached};
-use units::{NO_UNIT, Units, on_the_move, rest, units_to_sleep};
+use units::{NO_UNIT, Units, on_the_move, pressed_units, rest, units_to_sleep};
 
 /// Puts resting strands to sleep and wakes them.
 pub struct SleepPlugin;
@@ -93,6 +93,8 @@ pub struct SleepState {
     displacement: Vec<DVec2>,
     woken: Vec<bool>,
     reached: Vec<bool>,
+    /// Sleeping units an awake, unrested one touched: they wake at any speed.
+    pressed: Vec<bool>,
     sleepers: Vec<u32>,
     target: Vec<bool>,
     blocked: Vec<bool>,
@@ -363,6 +365,13 @@ fn sleep_and_wake(
         &mut sleep.blocked,
         &mut sleep.sleepers,
     );
+    pressed_units(
+        &sleep.asleep,
+        &sleep.rested,
+        config.sleep.time,
+        &sleep.contacts,
+        &mut sleep.pressed,
+    );
     sleep.contacts.clear();
     let mut target = std::mem::take(&mut sleep.target);
     copy_buffer(&mut target, &sleep.asleep);
@@ -388,8 +397,14 @@ fn sleep_and_wake(
     sleep.target = target;
 
     for u in 0..sleep.units.len() {
-        if sleep.asleep[u] && (sleep.woken[u] || sleep.reached[u]) {
+        if sleep.asleep[u] && (sleep.woken[u] || sleep.reached[u] || sleep.pressed[u]) {
+            let only_pressed = !(sleep.woken[u] || sleep.reached[u]);
             wake(sleep, u, &state, &mut commands);
+            if only_pressed {
+                // It was at rest and a touch has not moved it: it counts as rested, so
+                // it presses on its own sleeping neighbours only once it moves.
+                sleep.rested[u] = config.sleep.time;
+            }
             metrics.wakes += 1;
         }
     }

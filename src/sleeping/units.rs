@@ -167,6 +167,29 @@ pub fn units_to_sleep(
     }
 }
 
+/// The sleeping units something presses on: touched (by `contacts`) by an awake unit
+/// that has not rested `time` — still settling, creeping or pushed, at whatever speed.
+/// Marks them in `pressed`. A unit at rest on a sleeping one presses on nothing, so a
+/// touch wakes only a neighbourhood, not a whole pile.
+pub fn pressed_units(
+    asleep: &[bool],
+    rested: &[f64],
+    time: f64,
+    contacts: &[(u32, u32)],
+    pressed: &mut Vec<bool>,
+) {
+    let n = asleep.len();
+    pressed.clear();
+    pressed.resize(n, false);
+    for &(a, b) in contacts {
+        let (a, b) = (a as usize, b as usize);
+        if a < n && b < n && asleep[a] != asleep[b] {
+            let (awake, sleeping) = if asleep[a] { (b, a) } else { (a, b) };
+            pressed[sleeping] |= rested[awake] < time;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,5 +299,24 @@ mod tests {
         // Trembling, it is not on the move; drifting 1 mm a tick (1 cm/s), it is.
         assert!(!on_the_move(rested[0], strayed[0], 5e-3));
         assert!(on_the_move(rested[1], strayed[1], 5e-3));
+    }
+
+    #[test]
+    fn only_an_unrested_awake_unit_presses_on_a_sleeping_one() {
+        // Units 0 and 1 asleep, 2 awake and settling, 3 awake and rested.
+        let asleep = [true, true, false, false];
+        let rested = [0.0, 0.0, 0.4, 1.5];
+        let mut pressed = Vec::new();
+        pressed_units(
+            &asleep,
+            &rested,
+            1.0,
+            &[(0, 2), (1, 3), (2, 3)],
+            &mut pressed,
+        );
+        assert_eq!(pressed, [true, false, false, false]);
+        // Two sleeping units touching do not press on each other.
+        pressed_units(&asleep, &rested, 1.0, &[(0, 1)], &mut pressed);
+        assert_eq!(pressed, [false; 4]);
     }
 }
