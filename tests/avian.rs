@@ -307,10 +307,12 @@ fn a_crane_swings_a_crate_on_a_rope() {
 }
 
 /// The physics_world example's bridge: posts, ground and five crates dropped one after
-/// another onto the bridge.
-#[test]
-fn crates_dropped_one_after_another_pile_on_a_bridge() {
+/// another onto the bridge (the last at 6 s), in `substeps` steps a tick. Returns the
+/// crates' mean speed over each second from 9 s to 15 s; asserts that none falls
+/// through or flies off, every edge stays exact and nothing crosses at any step's end.
+fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
     let mut app = app(Vec2::new(0.0, -9.81));
+    app.world_mut().resource_mut::<StrandsConfig>().substeps = substeps;
     let solid = |app: &mut App, centre: Vec2, size: Vec2| {
         app.world_mut().spawn((
             RigidBody::Static,
@@ -323,13 +325,14 @@ fn crates_dropped_one_after_another_pile_on_a_bridge() {
     for x in [0.27, 1.13] {
         solid(&mut app, Vec2::new(x, 0.4), Vec2::new(0.04, 0.6));
     }
-    StrandBuilder::hanging(DVec2::new(0.3, 0.72), DVec2::new(1.1, 0.72), 40, 1.08)
+    let bridge = StrandBuilder::hanging(DVec2::new(0.3, 0.72), DVec2::new(1.1, 0.72), 40, 1.08)
         .mass(0.02)
         .material(StrandMaterial::INERT)
         .spawn_in(app.world_mut())
         .unwrap();
     let mut crates = Vec::new();
-    for k in 0..600 {
+    let mut means = Vec::new();
+    for k in 0..900 {
         if k % 72 == 71 && crates.len() < 5 {
             let x = [0.62, 0.8, 0.5, 0.95, 0.7][crates.len()];
             crates.push(
@@ -349,12 +352,50 @@ fn crates_dropped_one_after_another_pile_on_a_bridge() {
             let at = body_position(&app, c);
             assert!(
                 at.is_finite() && at.y > 0.0 && at.x.abs() < 3.0,
-                "tick {k}: a crate at {at}"
+                "{substeps} steps a tick, tick {k}: a crate at {at}"
             );
         }
+        assert_eq!(crossings(&app), 0, "{substeps} steps a tick, tick {k}");
+        if k >= 540 {
+            if k % 60 == 0 {
+                means.push(0.0);
+            }
+            let speed: f64 = crates
+                .iter()
+                .map(|&c| body_velocity(&app, c).length())
+                .sum();
+            *means.last_mut().unwrap() += speed / (5.0 * 60.0);
+        }
+    }
+    let lowest = strand_particles(&app, bridge)
+        .iter()
+        .map(|&p| position(&app, p).y)
+        .fold(f64::INFINITY, f64::min);
+    for &c in &crates {
+        let at = body_position(&app, c);
+        assert!(at.y > lowest, "a crate at {at} under the bridge ({lowest})");
     }
     assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
-    assert_eq!(crossings(&app), 0);
+    means
+}
+
+/// Five crates piled on the bridge at 1, 4 and 10 steps a tick: no crossing at any (a
+/// frame's vertex snapped to the engine's pose once put a crate's corner through the
+/// bridge at 1 and 4), and the crates lie on it. They do not yet come to rest: the
+/// force the engine applies over its step moves them otherwise than the strands did,
+/// and they rock at 5 to 20 mm/s (the bodies-on-ropes issue goes on); the bound only
+/// says they do not whirl.
+#[test]
+fn crates_dropped_one_after_another_pile_on_a_bridge() {
+    for substeps in [1, 4, 10] {
+        let means = crates_on_a_bridge(substeps);
+        eprintln!("{substeps}: {means:?}");
+        let last = *means.last().unwrap();
+        assert!(
+            last.is_finite() && last < 0.03,
+            "{substeps} steps a tick: the crates' mean speed each second {means:?}"
+        );
+    }
 }
 
 /// A crate on a light rope (3 % of its mass), let go at an angle, swings with the

@@ -111,7 +111,7 @@ pub(super) fn follow_bodies(
     if !(tick.is_finite() && tick > 0.0) {
         return;
     }
-    // A particle coupled to a dynamic body starts the tick where the body has it, when
+    // A lone anchor coupled to a dynamic body starts the tick where the body has it, when
     // it is that close: moved by so little no strand can be passed, and with no
     // velocity of its own to bring it back, so nothing the body did not do is fed
     // back to it.
@@ -173,10 +173,13 @@ pub(super) fn follow_bodies(
                 let rigid = frame.start.linear.as_dvec2() + frame.start.angular as f64 * arm.perp();
                 velocity.set_if_neq(Velocity(rigid));
             }
-        } else if dynamic && off.length() < snap {
+        } else if dynamic && !framed && off.length() < snap {
             moves.push((entity, point));
             velocity.set_if_neq(Velocity(point_velocity));
         } else {
+            // A frame's vertex is never moved there: the frame would jump, and a strand
+            // lying against it could end up inside (a crate's corner through the rope
+            // bridge it rests on). Driven there through the tick, the contacts see it.
             velocity.set_if_neq(Velocity(point_velocity + off / tick));
         }
         if dynamic == kinematic {
