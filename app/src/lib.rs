@@ -16,6 +16,7 @@ pub mod export;
 pub mod fixtures;
 pub mod free;
 pub mod initial_state;
+pub mod profile;
 pub mod report;
 pub mod runner;
 pub mod scenario;

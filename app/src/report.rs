@@ -4,6 +4,8 @@ use bevy_strands::metrics::CrossingEvent;
 use bevy_strands::world::topology::Topology;
 use serde::Serialize;
 
+use crate::profile::StageShare;
+
 /// The first step end with crossed edges, told in terms a reader can find again.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct CrossingReport {
@@ -173,12 +175,16 @@ pub struct Report {
     pub input_problems: Vec<String>,
     /// Pictures written (GIF, PNG frames, plot).
     pub pictures: Vec<String>,
+    /// Each stage's share of the wall time (with `--profile`; empty otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stage_profile: Vec<StageShare>,
 }
 
 impl Report {
     /// The fields measured by the wall clock: they differ between identical runs.
-    pub const WALL_CLOCK_FIELDS: [&'static str; 4] = [
+    pub const WALL_CLOCK_FIELDS: [&'static str; 5] = [
         "threads",
+        "stage_profile",
         "wall_seconds",
         "particle_steps_per_second",
         "real_time_factor",
@@ -304,6 +310,17 @@ impl Report {
         }
         for picture in &self.pictures {
             out.push_str(&format!("wrote {picture}\n"));
+        }
+        if !self.stage_profile.is_empty() {
+            out.push_str("where the wall time went (share of the ticks' wall time):\n");
+            for row in &self.stage_profile {
+                out.push_str(&format!(
+                    "  {:<46} {:>6.2} %  {:.4} s\n",
+                    row.stage,
+                    100.0 * row.share,
+                    row.seconds
+                ));
+            }
         }
         out
     }

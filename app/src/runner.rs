@@ -18,6 +18,7 @@ use crate::energy::EnergyLedger;
 use crate::export::plot::plot_length_error;
 use crate::export::{ExportError, FrameSettings, Recorder};
 use crate::free::FreeSpeeds;
+use crate::profile::{StageProfile, add_stage_markers};
 use crate::report::{CrossingReport, IslandReport, Report};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::scenes::ScenesPlugin;
@@ -83,6 +84,8 @@ pub struct RunOptions {
     pub from: Option<PathBuf>,
     /// End the run at the first step that ends with crossed edges.
     pub stop_on_crossing: bool,
+    /// Time each stage of the tick and the step (`StageProfile`), for the report.
+    pub profile: bool,
 }
 
 /// Why a run could not start or finish.
@@ -262,6 +265,9 @@ pub fn run(options: &RunOptions, mut progress: impl FnMut(f64)) -> Result<Report
             (scene, app)
         }
     };
+    if options.profile {
+        add_stage_markers(&mut app);
+    }
     let world = app.world_mut();
     if options.check_crossings {
         let mut metrics = world.resource_mut::<StrandMetrics>();
@@ -578,5 +584,9 @@ fn report(
         notes,
         input_problems,
         pictures: Vec::new(),
+        stage_profile: world
+            .get_resource::<StageProfile>()
+            .map(|profile| profile.shares(wall_seconds))
+            .unwrap_or_default(),
     }
 }

@@ -132,3 +132,49 @@ fn a_factorization_shared_between_threads_gives_the_same_report() {
         one.max_rel_length_error
     );
 }
+
+/// `--profile`'s markers only read the clock: a profiled run computes the same, and its
+/// stages account for the ticks' wall time (each share finite, the tick's phases
+/// together most of it and never more).
+#[test]
+fn a_profiled_run_computes_the_same_and_accounts_for_its_time() {
+    let options = |profile| RunOptions {
+        scenario: "long_strand".into(),
+        seconds: Some(0.5),
+        threads: Some(1),
+        check_crossings: true,
+        profile,
+        ..Default::default()
+    };
+    let plain = run(&options(false), |_| {}).unwrap();
+    let profiled = run(&options(true), |_| {}).unwrap();
+    assert!(plain.stage_profile.is_empty());
+    assert_eq!(figures(&plain), figures(&profiled));
+    let shares = &profiled.stage_profile;
+    assert!(
+        shares
+            .iter()
+            .all(|s| s.seconds.is_finite() && s.seconds >= 0.0 && s.share.is_finite()),
+        "{shares:?}"
+    );
+    let total = |prefix: &str| -> f64 {
+        shares
+            .iter()
+            .filter(|s| s.stage.starts_with(prefix))
+            .map(|s| s.share)
+            .sum()
+    };
+    assert!(
+        (0.5..=1.0 + 1e-9).contains(&total("tick:")),
+        "the tick's phases: {shares:?}"
+    );
+    let steps = shares
+        .iter()
+        .find(|s| s.stage == "tick: steps")
+        .unwrap()
+        .share;
+    assert!(
+        total("step:") > 0.0 && total("step:") <= steps + 1e-9,
+        "the step's stages within the steps' phase: {shares:?}"
+    );
+}

@@ -128,6 +128,10 @@ struct RunArgs {
     /// End the run at the first step that ends with crossed edges.
     #[arg(long)]
     stop_on_crossing: bool,
+    /// Report each stage's share of the wall time (the tick's phases and the step's
+    /// stages; the simulation computes the same).
+    #[arg(long)]
+    profile: bool,
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -192,6 +196,7 @@ fn main() -> ExitCode {
                 snapshot: args.snapshot,
                 from: args.from,
                 stop_on_crossing: args.stop_on_crossing,
+                profile: args.profile,
                 frame_settings: FrameSettings {
                     fps: args.fps,
                     width: args.size.0,
