@@ -27,5 +27,7 @@ mkdir -p "$out"
 wasm-bindgen --target web --no-typescript --remove-name-section --remove-producers-section --out-dir "$out" --out-name strands \
     target/wasm32-unknown-unknown/web/examples/web.wasm
 cp app/web/index.html "$out/"
+wasm="$out/strands_bg.wasm"
+echo "the page's wasm: $(wc -c < "$wasm") bytes, $(gzip -9 -c "$wasm" | wc -c) gzipped"
 echo "the web demo is in $out: serve it, e.g. python3 -m http.server -d $out 8080,"
 echo "and open http://localhost:8080 (?scene=meatball_factory or ?scene=long_strand)"

@@ -170,7 +170,14 @@ def report(name, f, colours, share):
 
 
 def factory(page, url, out, scene, seconds):
+    opened = time.monotonic()
     page.goto(f"{url}/?scene={scene}")
+    wait_for(page, lambda f: f["scene"] == scene and f["frames"] >= 1, LOAD_TIMEOUT,
+             f"{scene}'s first frame")
+    # Measured, not asserted: how long a visitor waits for a picture (the wasm fetched,
+    # compiled and started; the first page of a browser session is the cold one).
+    print(f"{scene}: first frame drawn {time.monotonic() - opened:.1f} s after the page "
+          f"was opened", flush=True)
     wait_for(page, lambda f: f["scene"] == scene and f["steps"] > 0, LOAD_TIMEOUT,
              f"{scene} to start")
     counts = []

@@ -114,8 +114,10 @@ impl Plugin for StrandsUiPlugin {
             })
             .add_plugins(ScreenshotPlugin)
             .add_systems(EguiPrimaryContextPass, panel)
-            .add_systems(Update, (shortcuts, use_tools, trim_history))
-            .add_systems(PostUpdate, export_frames);
+            .add_systems(Update, (shortcuts, use_tools, trim_history));
+        // A page has no folder to write frames into, and leaves the encoders out.
+        #[cfg(not(target_arch = "wasm32"))]
+        app.add_systems(PostUpdate, export_frames);
     }
 }
 
@@ -419,7 +421,7 @@ fn shortcuts(
     if pressed(bindings.reset) {
         commands.queue(reset);
     }
-    if pressed(bindings.record) {
+    if pressed(bindings.record) && cfg!(not(target_arch = "wasm32")) {
         commands.queue(toggle_export);
     }
     if pressed(bindings.more_substeps) {
@@ -463,6 +465,7 @@ pub fn reset(world: &mut World) {
     spawn_active_scenario(world);
 }
 
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 fn toggle_export(world: &mut World) {
     let view = world
         .get_resource::<ActiveScenario>()
@@ -493,6 +496,7 @@ fn toggle_export(world: &mut World) {
     }
 }
 
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 fn export_frames(world: &mut World) {
     let Some(mut recorder) = world.resource_mut::<FrameExport>().recorder.take() else {
         return;
