@@ -15,29 +15,36 @@ use bevy_strands::schedule::{
 };
 use serde::Serialize;
 
-/// The phases of a tick, as the report names them.
-const TICK_STAGES: [&str; 6] = [
-    "tick: scene logic",
-    "tick: sleeping and waking",
-    "tick: topology",
-    "tick: gather",
-    "tick: steps",
-    "tick: write-back",
-];
+/// The phases of a tick in their order, each with the name the report gives it.
+fn tick_stages() -> [(&'static str, InternedSystemSet); 6] {
+    [
+        ("tick: scene logic", TickSet::Prepare.intern()),
+        ("tick: sleeping and waking", TickSet::Sleep.intern()),
+        ("tick: topology", TickSet::Topology.intern()),
+        ("tick: gather", TickSet::Gather.intern()),
+        (STEPS, TickSet::Step.intern()),
+        ("tick: write-back", TickSet::Writeback.intern()),
+    ]
+}
 
-/// The stages of a step, as the report names them.
-const STEP_STAGES: [&str; 10] = [
-    "step: forces",
-    "step: predict",
-    "step: edge projection",
-    "step: contact solve",
-    "step: proximity",
-    "step: impulses",
-    "step: contact loop",
-    "step: collision figures",
-    "step: integrate",
-    "step: measure",
-];
+/// The tick's phase that runs the steps.
+const STEPS: &str = "tick: steps";
+
+/// The stages of a step in their order, each with the name the report gives it.
+fn step_stages() -> [(&'static str, InternedSystemSet); 10] {
+    [
+        ("step: forces", StepSet::Forces.intern()),
+        ("step: predict", StepSet::Predict.intern()),
+        ("step: edge projection", ConstrainSet::Project.intern()),
+        ("step: contact solve", ConstrainSet::Speculate.intern()),
+        ("step: proximity", CollideSet::Proximity.intern()),
+        ("step: impulses", CollideSet::Impulses.intern()),
+        ("step: contact loop", CollideSet::ContactLoop.intern()),
+        ("step: collision figures", CollideSet::Account.intern()),
+        ("step: integrate", StepSet::Integrate.intern()),
+        ("step: measure", StepSet::Measure.intern()),
+    ]
+}
 
 /// One stage's share of a run's wall time.
 #[derive(Serialize, Clone, Debug, PartialEq)]
@@ -86,36 +93,30 @@ impl StageProfile {
     /// tick's phases, then the step's stages, then what the steps' phase spent outside
     /// them (step halving's copies, the guard between stages, the step loop).
     pub fn shares(&self, wall_seconds: f64) -> Vec<StageShare> {
-        let tick = |k: usize| self.tick.totals.get(k).copied().unwrap_or(0.0);
-        let step = |k: usize| self.step.totals.get(k).copied().unwrap_or(0.0);
-        let in_steps: f64 = (0..STEP_STAGES.len()).map(step).sum();
-        let share = |seconds: f64| {
-            if wall_seconds > 0.0 {
-                seconds / wall_seconds
-            } else {
-                0.0
-            }
+        let timed = |stages: &[(&'static str, InternedSystemSet)], clock: &StageClock| {
+            let total = |k: usize| clock.totals.get(k).copied().unwrap_or(0.0);
+            (stages.iter().enumerate())
+                .map(|(k, &(name, _))| (name, total(k)))
+                .collect::<Vec<_>>()
         };
-        let mut rows: Vec<(&str, f64)> = TICK_STAGES
-            .iter()
-            .enumerate()
-            .map(|(k, &name)| (name, tick(k)))
-            .collect();
-        rows.extend(
-            STEP_STAGES
-                .iter()
-                .enumerate()
-                .map(|(k, &name)| (name, step(k))),
-        );
+        let mut rows = timed(&tick_stages(), &self.tick);
+        let steps = rows.iter().find(|r| r.0 == STEPS).map_or(0.0, |r| r.1);
+        let stages = timed(&step_stages(), &self.step);
+        let in_stages: f64 = stages.iter().map(|r| r.1).sum();
+        rows.extend(stages);
         rows.push((
             "step: between stages (halving, guard, loop)",
-            (tick(4) - in_steps).max(0.0),
+            (steps - in_stages).max(0.0),
         ));
         rows.into_iter()
             .map(|(stage, seconds)| StageShare {
                 stage: stage.to_string(),
                 seconds,
-                share: share(seconds),
+                share: if wall_seconds > 0.0 {
+                    seconds / wall_seconds
+                } else {
+                    0.0
+                },
             })
             .collect()
     }
@@ -124,37 +125,18 @@ impl StageProfile {
 /// Add the markers to `app`'s schedules (before or after the app is finished).
 pub fn add_stage_markers(app: &mut App) {
     app.init_resource::<StageProfile>();
-    let tick: [InternedSystemSet; 6] = [
-        TickSet::Prepare.intern(),
-        TickSet::Sleep.intern(),
-        TickSet::Topology.intern(),
-        TickSet::Gather.intern(),
-        TickSet::Step.intern(),
-        TickSet::Writeback.intern(),
-    ];
-    let step: [InternedSystemSet; 10] = [
-        StepSet::Forces.intern(),
-        StepSet::Predict.intern(),
-        ConstrainSet::Project.intern(),
-        ConstrainSet::Speculate.intern(),
-        CollideSet::Proximity.intern(),
-        CollideSet::Impulses.intern(),
-        CollideSet::ContactLoop.intern(),
-        CollideSet::Account.intern(),
-        StepSet::Integrate.intern(),
-        StepSet::Measure.intern(),
-    ];
-    markers(app, StrandsTick, &tick, |p| &mut p.tick);
-    markers(app, StrandsStep, &step, |p| &mut p.step);
+    markers(app, StrandsTick, &tick_stages(), |p| &mut p.tick);
+    markers(app, StrandsStep, &step_stages(), |p| &mut p.step);
 }
 
 /// A marker before each of `sets` and one after the last: marker `k` starts stage `k`.
 fn markers(
     app: &mut App,
     schedule: impl ScheduleLabel + Clone,
-    sets: &[InternedSystemSet],
+    stages: &[(&'static str, InternedSystemSet)],
     clock: fn(&mut StageProfile) -> &mut StageClock,
 ) {
+    let sets: Vec<InternedSystemSet> = stages.iter().map(|&(_, set)| set).collect();
     let count = sets.len();
     for k in 0..=count {
         let marker = move |mut profile: ResMut<StageProfile>| clock(&mut profile).mark(k, count);
