@@ -208,19 +208,9 @@ struct CheckParams<'w, 's> {
 
 /// After `stage`: hold what this tick froze, then scan `quantity` and freeze the
 /// islands of any non-finite particle.
-fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
-    let CheckParams {
-        mut guard,
-        mut state,
-        topology,
-        clock,
-        config,
-        strands,
-        mut messages,
-    } = params;
-    let guard = &mut *guard;
-    let state = &mut *state;
-    hold_frozen(guard, state);
+fn check_stage(stage: StepSet, quantity: Quantity, mut params: CheckParams) {
+    hold_frozen(&params.guard, &mut params.state);
+    let state = &params.state;
     let values = match quantity {
         Quantity::Force => &state.force,
         Quantity::Velocity => &state.velocity,
@@ -234,74 +224,54 @@ fn check_stage(stage: StepSet, quantity: Quantity, params: CheckParams) {
         .filter(|&i| !values[i].is_finite())
         .collect();
     // The Integrate stage has already counted the step.
-    let step = clock.steps + u64::from(stage != StepSet::Integrate);
-    let context = (&*topology, &*config, &strands, &mut messages);
-    freeze_and_report(
-        guard,
-        state,
-        context,
-        &bad,
-        (step, stage, first, quantity, value),
-    );
+    let step = params.clock.steps + u64::from(stage != StepSet::Integrate);
+    params.freeze_and_report(&bad, (step, stage, first, quantity, value));
 }
 
-/// Freeze the islands of the `bad` packed particles, and say so: the event (the step,
-/// its stage, the `first` particle, the quantity and its value) as a message, in the
-/// guard's record and in the log.
-fn freeze_and_report(
-    guard: &mut FiniteGuard,
-    state: &mut ParticleState,
-    (topology, config, strands, messages): (
-        &Topology,
-        &StrandsConfig,
-        &Query<&StrandOf>,
-        &mut MessageWriter<NonFiniteState>,
-    ),
-    bad: &[usize],
-    (step, stage, first, quantity, value): (u64, StepSet, usize, Quantity, DVec2),
-) {
-    let before = guard.frozen.len();
-    freeze_islands(guard, state, topology, bad);
-    hold_frozen(guard, state);
-    let particle = state.entity[first];
-    let event = NonFiniteState {
-        step,
-        time: step.saturating_sub(1) as f64 * config.dt,
-        stage,
-        particle,
-        strand: strands.get(particle).ok().map(|of| of.0),
-        quantity,
-        value,
-        bad_particles: bad.len(),
-        frozen_particles: guard.frozen.len() - before,
-    };
-    error!(
-        "bevy_strands: step {step}, {stage:?} stage: particle {particle} has {} {value}; \
-         {} particles frozen",
-        quantity.name(),
-        event.frozen_particles
-    );
-    messages.write(event.clone());
-    guard.events.push(event);
+impl CheckParams<'_, '_> {
+    /// Freeze the islands of the `bad` packed particles, and say so: the event (the
+    /// step, its stage, the `first` particle, the quantity and its value) as a
+    /// message, in the guard's record and in the log.
+    fn freeze_and_report(
+        &mut self,
+        bad: &[usize],
+        (step, stage, first, quantity, value): (u64, StepSet, usize, Quantity, DVec2),
+    ) {
+        let (guard, state) = (&mut *self.guard, &mut *self.state);
+        let before = guard.frozen.len();
+        freeze_islands(guard, state, &self.topology, bad);
+        hold_frozen(guard, state);
+        let particle = state.entity[first];
+        let event = NonFiniteState {
+            step,
+            time: step.saturating_sub(1) as f64 * self.config.dt,
+            stage,
+            particle,
+            strand: self.strands.get(particle).ok().map(|of| of.0),
+            quantity,
+            value,
+            bad_particles: bad.len(),
+            frozen_particles: guard.frozen.len() - before,
+        };
+        error!(
+            "bevy_strands: step {step}, {stage:?} stage: particle {particle} has {} {value}; \
+             {} particles frozen",
+            quantity.name(),
+            event.frozen_particles
+        );
+        self.messages.write(event.clone());
+        guard.events.push(event);
+    }
 }
 
 /// After the Measure stage (its errors measured): freeze the islands of constrained
 /// edges stretched past [`MAX_STRETCH`] (nothing to scan while the step's largest error
 /// is below it).
-fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics>) {
+fn check_stretch(mut params: CheckParams, metrics: Res<crate::metrics::StrandMetrics>) {
     if metrics.max_rel_length_error_now <= MAX_STRETCH {
         return;
     }
-    let CheckParams {
-        mut guard,
-        mut state,
-        topology,
-        clock,
-        config,
-        strands,
-        mut messages,
-    } = params;
-    let (guard, state) = (&mut *guard, &mut *state);
+    let (guard, topology) = (&params.guard, &params.topology);
     let errors = &metrics.relative_length_error;
     let stretched = |k: usize| {
         let e = &topology.edges[k];
@@ -334,42 +304,50 @@ fn check_stretch(params: CheckParams, metrics: Res<crate::metrics::StrandMetrics
     };
     bad.sort_unstable();
     bad.dedup();
-    let context = (&*topology, &*config, &strands, &mut messages);
     let event = (
-        clock.steps,
+        params.clock.steps,
         StepSet::Measure,
         first,
         Quantity::Stretch,
         DVec2::new(error, 0.0),
     );
-    freeze_and_report(guard, state, context, &bad, event);
+    params.freeze_and_report(&bad, event);
 }
 
 /// At a tick's end: compare the scene's energy with what its forces explain, and freeze
 /// the island of the most energetic particle if it has far more.
 fn check_energy(
-    params: CheckParams,
+    mut params: CheckParams,
     collision: Res<crate::world::config::CollisionConfig>,
     tethers: Query<(), With<crate::world::particle::Tether>>,
 ) {
-    let CheckParams {
-        mut guard,
-        mut state,
-        topology,
-        clock,
-        config,
-        strands,
-        mut messages,
-    } = params;
-    let (guard, state) = (&mut *guard, &mut *state);
-    if state.is_empty() || guard.energy.tick_start.len() != state.len() {
+    let Some(first) = unexplained(&mut params, collision.thickness, !tethers.is_empty()) else {
         return;
+    };
+    let value = params.state.velocity[first];
+    let event = (
+        params.clock.steps,
+        StepSet::Measure,
+        first,
+        Quantity::Speed,
+        value,
+    );
+    params.freeze_and_report(&[first], event);
+}
+
+/// The most energetic counted particle when the scene's energy is more than its forces
+/// explain (settling the account at the tick's end), or `None`.
+fn unexplained(params: &mut CheckParams, thickness: f64, tethered: bool) -> Option<usize> {
+    let (guard, state) = (&mut *params.guard, &*params.state);
+    let (topology, config) = (&params.topology, &params.config);
+    if state.is_empty() || guard.energy.tick_start.len() != state.len() {
+        return None;
     }
     let frozen_now = guard.frozen.len() != guard.marked;
-    let driven = frozen_now || energy::driven(state, !tethers.is_empty());
+    let driven = frozen_now || energy::driven(state, tethered);
     let account = &mut guard.energy;
     if !account.accrue(state, driven) {
-        return;
+        return None;
     }
     let (edges, bends) = (&topology.edges[..], &topology.bends[..]);
     let changed = account.count(state, edges, bends);
@@ -386,23 +364,16 @@ fn check_energy(
         .filter(|(_, c)| **c)
         .map(|(m, _)| m)
         .sum();
-    let slack = energy::slack(free_mass, config.gravity, collision.thickness, config.dt);
+    let slack = energy::slack(free_mass, config.gravity, thickness, config.dt);
     if account.settle(energy, work, slack, changed || driven) != energy::Verdict::Unexplained {
-        return;
+        return None;
     }
-    let Some(first) = (0..state.len())
+    (0..state.len())
         .filter(|&i| account.counted[i])
         .max_by(|&i, &j| {
             let e = |k: usize| state.mass[k] * state.velocity[k].length_squared();
             e(i).total_cmp(&e(j))
         })
-    else {
-        return;
-    };
-    let value = state.velocity[first];
-    let context = (&*topology, &*config, &strands, &mut messages);
-    let event = (clock.steps, StepSet::Measure, first, Quantity::Speed, value);
-    freeze_and_report(guard, state, context, &[first], event);
 }
 
 /// Freeze the islands of the `bad` packed particles at the step's start.
