@@ -18,7 +18,7 @@ use bevy_strands::constraints::islands::find_islands;
 use bevy_strands::constraints::projection::{
     Bodies, Chain, Graph, IslandScratch, IslandView, project_chain, project_island,
 };
-use bevy_strands::constraints::tridiagonal::solve_tridiagonal;
+use bevy_strands::linalg::tridiagonal::solve_tridiagonal;
 use bevy_strands::metrics::IterationStats;
 use bevy_strands::model::Edge;
 use bevy_strands::prelude::*;

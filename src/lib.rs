@@ -47,6 +47,7 @@ pub mod contact_loop;
 pub mod forces;
 pub mod guard;
 pub mod integrate;
+pub mod linalg;
 pub mod metrics;
 pub mod model;
 pub mod parallel;

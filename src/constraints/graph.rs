@@ -6,7 +6,7 @@
 //! unknown k of the factor and the projection needs no permutation.
 
 use super::island_edge::IslandEdge;
-use super::sparse::SparsePlan;
+use crate::linalg::sparse::SparsePlan;
 
 /// An off-diagonal entry of `J W Jᵀ`: edges k and l meet at a free particle.
 #[derive(Clone, Copy, Debug, PartialEq)]

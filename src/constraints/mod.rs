@@ -4,23 +4,18 @@
 //! projected so that each constrained edge ends the step at its rest length. Islands
 //! are found once per topology change ([`islands`]); the kind of an island picks its
 //! solver ([`solver`]). The kernels are pure functions on slices: the linear solves
-//! ([`tridiagonal`], [`cyclic`], [`sparse`] on a [`graph`] layout), the projection with
+//! (in [`crate::linalg`], on a [`graph`] layout for trees and graphs), the projection with
 //! the joint projection of islands in contact ([`projection`]) and the relaxation baselines
 //! ([`relaxation`]); [`plugin`] holds the thin systems.
 
-pub mod cyclic;
 pub mod graph;
 pub mod island_edge;
 pub mod islands;
 pub mod joint_groups;
-pub mod ldl;
 pub mod plugin;
 pub mod projection;
 pub mod relaxation;
 pub mod solver;
-pub mod sparse;
-pub mod supernodal;
-pub mod tridiagonal;
 
 pub use plugin::{ConstraintsPlugin, Islands};
 pub use solver::SolverKind;

@@ -38,8 +38,8 @@
 use bevy::math::DVec2;
 
 use super::bending::bend_gradient;
-use crate::constraints::sparse::{SparseFactor, SparsePlan};
-use crate::constraints::tridiagonal::SingularPivot;
+use crate::linalg::SingularPivot;
+use crate::linalg::sparse::{SparseFactor, SparsePlan};
 use crate::model::Bend;
 use crate::model::geometry::{turning_angle, wrap_angle};
 

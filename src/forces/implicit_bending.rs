@@ -20,8 +20,8 @@
 use bevy::math::{DMat2, DVec2};
 
 use super::quadratic_bending::{bend_matrices, bend_vector};
-use crate::constraints::sparse::{SparseFactor, SparsePlan};
-use crate::constraints::tridiagonal::SingularPivot;
+use crate::linalg::SingularPivot;
+use crate::linalg::sparse::{SparseFactor, SparsePlan};
 use crate::model::Bend;
 
 const NONE: u32 = u32::MAX;

@@ -7,7 +7,8 @@ use bevy::math::DVec2;
 use super::scratch::IslandScratch;
 use super::settings::ConstraintDirection;
 use crate::constraints::graph::GraphLayout;
-use crate::constraints::tridiagonal::{SingularPivot, solve_tridiagonal};
+use crate::linalg::SingularPivot;
+use crate::linalg::tridiagonal::solve_tridiagonal;
 
 /// Assemble the tridiagonal (or cyclic) system of a chain and solve it for the
 /// right-hand side in `s.rhs`, keeping the factor when contact columns will follow.

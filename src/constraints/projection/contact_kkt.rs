@@ -8,14 +8,15 @@
 //!
 //! The particles are ordered by geometric nested dissection (`ordering`), each edge's
 //! multiplier right after the later of its two particles, so the sparse LDLᵀ
-//! (`ldl`) needs no pivoting. The pattern holds every row of the projection, pressed
+//! (`linalg::symbolic`) needs no pivoting. The pattern holds every row of the projection, pressed
 //! or not, and is analysed once per projection; each Newton step only refills values.
 
 use bevy::math::DVec2;
 
 use super::joint_row::JointRow;
-use crate::constraints::ldl::{BadPivot, LdlPattern};
-use crate::constraints::supernodal::{SupernodalFactor, SupernodalPlan};
+use crate::linalg::SingularPivot;
+use crate::linalg::supernodal::{SupernodalFactor, SupernodalPlan};
+use crate::linalg::symbolic::LdlPattern;
 
 /// Not an unknown (a fixed particle, a locked edge).
 pub(super) const NONE: u32 = u32::MAX;
@@ -352,7 +353,7 @@ impl Kkt {
         model: &[RowModel],
         edge: &[DVec2],
         curvature: &[f64],
-    ) -> Result<(), BadPivot> {
+    ) -> Result<(), SingularPivot> {
         self.value.fill(0.0);
         let mut at = 0usize;
         let (slot, value) = (&self.slot, &mut self.value);

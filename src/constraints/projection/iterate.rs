@@ -11,7 +11,7 @@ use super::settings::{
 };
 use super::walk::Walk;
 use crate::constraints::island_edge::IslandEdge;
-use crate::constraints::tridiagonal::SingularPivot;
+use crate::linalg::SingularPivot;
 
 /// Past the iteration cap a projection goes on while every `STEADY_WINDOW` Newton
 /// steps cut the residual by at least `STEADY_RATE` ...

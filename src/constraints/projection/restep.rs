@@ -22,7 +22,7 @@ use super::settings::{
 };
 use super::walk::Walk;
 use crate::constraints::island_edge::IslandEdge;
-use crate::constraints::tridiagonal::SingularPivot;
+use crate::linalg::SingularPivot;
 
 /// How many times the iteration cap the finest substeps may take.
 const DEEPEST_BUDGET: u32 = 16;

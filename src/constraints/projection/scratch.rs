@@ -3,9 +3,9 @@
 
 use bevy::math::DVec2;
 
-use crate::constraints::cyclic::CyclicFactor;
-use crate::constraints::sparse::SparseFactor;
-use crate::constraints::tridiagonal::TridiagonalFactor;
+use crate::linalg::cyclic::CyclicFactor;
+use crate::linalg::sparse::SparseFactor;
+use crate::linalg::tridiagonal::TridiagonalFactor;
 
 /// Reusable buffers for [`project_island`](super::project_island), sized by
 /// [`IslandScratch::reserve`].

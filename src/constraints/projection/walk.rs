@@ -7,7 +7,7 @@ use super::scratch::{Factors, IslandScratch};
 use super::settings::ConstraintDirection;
 use crate::constraints::graph::GraphLayout;
 use crate::constraints::island_edge::IslandEdge;
-use crate::constraints::tridiagonal::SingularPivot;
+use crate::linalg::SingularPivot;
 
 /// An island's particles, edges and system.
 pub(super) trait Walk: Copy {

@@ -17,9 +17,8 @@
 /// No parent in the elimination tree.
 const ROOT: u32 = u32::MAX;
 
-/// A pivot below this fraction of its scale marks a dependent constraint.
 #[cfg(test)]
-const DEPENDENT_PIVOT: f64 = 1e-10;
+use super::pivot::{Pivot, SingularPivot, quasi_definite};
 
 /// The pattern of a symmetric matrix's upper triangle, by column, and its elimination
 /// tree and column counts.
@@ -49,14 +48,6 @@ pub struct LdlFactor {
     flag: Vec<u32>,
     /// Unknowns dropped as dependent in the last factorization.
     pub dropped: u32,
-}
-
-/// A pivot of the wrong sign or not finite: the matrix is not quasi-definite in this
-/// order (a bug in the caller's numbering, or values that overflowed).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BadPivot {
-    /// The unknown whose pivot failed.
-    pub unknown: usize,
 }
 
 impl LdlPattern {
@@ -145,7 +136,7 @@ impl LdlPattern {
 impl LdlFactor {
     /// Factor the matrix with pattern `p` and values `value` (aligned with `p.row`).
     /// `scale[k]` is unknown k's natural pivot size: a pivot below
-    /// [`DEPENDENT_PIVOT`] of it is dropped when `negative[k]` (an edge), and is an
+    /// [`DEPENDENT_PIVOT`](super::pivot::DEPENDENT_PIVOT) of it is dropped when `negative[k]` (an edge), and is an
     /// error otherwise. Each unknown's pivot must have the sign `negative` gives it.
     pub fn factor(
         &mut self,
@@ -153,7 +144,7 @@ impl LdlFactor {
         value: &[f64],
         scale: &[f64],
         negative: &[bool],
-    ) -> Result<(), BadPivot> {
+    ) -> Result<(), SingularPivot> {
         let n = p.len();
         let size = p.factor_size();
         self.l_row.resize(size, 0);
@@ -207,13 +198,14 @@ impl LdlFactor {
                 self.l_value[end] = l_ki;
                 self.l_count[i] += 1;
             }
-            let wrong_sign = if negative[k] { d >= 0.0 } else { d <= 0.0 };
-            if negative[k] && (d.abs() <= DEPENDENT_PIVOT * scale[k] || wrong_sign) {
-                // Dependent: its multiplier is zero, and later rows see no coupling.
-                d = f64::NEG_INFINITY;
-                self.dropped += 1;
-            } else if wrong_sign || !d.is_finite() {
-                return Err(BadPivot { unknown: k });
+            match quasi_definite(d, scale[k], negative[k]) {
+                Pivot::Drop => {
+                    // Dependent: its multiplier is zero, and later rows see no coupling.
+                    d = f64::NEG_INFINITY;
+                    self.dropped += 1;
+                }
+                Pivot::Fail => return Err(SingularPivot { row: k }),
+                Pivot::Keep => {}
             }
             self.diagonal[k] = d;
         }
@@ -398,6 +390,6 @@ mod tests {
         let a = vec![vec![-1.0, 0.0], vec![0.0, 1.0]];
         let (p, value) = upper(&a);
         let error = LdlFactor::default().factor(&p, &value, &[1.0; 2], &[false, false]);
-        assert_eq!(error, Err(BadPivot { unknown: 0 }));
+        assert_eq!(error, Err(SingularPivot { row: 0 }));
     }
 }

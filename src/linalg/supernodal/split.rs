@@ -4,7 +4,8 @@
 //! sequential factorization would have left, so every later front adds the same
 //! updates in the same order: the factor is the same bit for bit.
 
-use super::{BadPivot, NONE, SupernodalFactor, SupernodalPlan, Values};
+use super::{NONE, SupernodalFactor, SupernodalPlan, Values};
+use crate::linalg::pivot::SingularPivot;
 
 /// Less than this much work (multiply–adds, about 0.2 ns each) on the smaller side is
 /// not worth a thread (spawning one costs some tens of microseconds).
@@ -94,7 +95,7 @@ impl SupernodalFactor {
         plan: &SupernodalPlan,
         split: Split,
         values: Values,
-    ) -> Result<(), BadPivot> {
+    ) -> Result<(), SingularPivot> {
         let Split { first, middle, end } = split;
         let nodes = plan.first.len();
         let fronts = &mut self.fronts;

@@ -9,18 +9,16 @@
 //! factorization's, done in dense loops over contiguous memory, and the fronts are
 //! visited children first, so their updates are a stack.
 //!
-//! Pivots are of one sign per unknown, as [`ldl`](super::ldl) explains; an edge whose
+//! Pivots are of one sign per unknown, as [`symbolic`](super::symbolic) explains; an edge whose
 //! pivot vanishes is dropped (its multiplier is zero).
 
 mod split;
 
-use super::ldl::{BadPivot, LdlPattern};
+use super::pivot::{Pivot, SingularPivot, quasi_definite};
+use super::symbolic::LdlPattern;
 
 /// No supernode.
 const NONE: u32 = u32::MAX;
-
-/// A pivot below this fraction of its scale marks a dependent constraint.
-const DEPENDENT_PIVOT: f64 = 1e-10;
 
 /// The supernodes of a pattern, their fronts' rows and the order they are factored in.
 #[derive(Clone, Debug, Default)]
@@ -378,7 +376,7 @@ impl SupernodalPlan {
 impl SupernodalFactor {
     /// Factor the matrix of `plan` with values `value` (aligned with its pattern's
     /// entries). `scale[k]` is unknown k's natural pivot size: a pivot below
-    /// `DEPENDENT_PIVOT` of it is dropped when `negative[k]` (an edge), and is an
+    /// [`DEPENDENT_PIVOT`](super::pivot::DEPENDENT_PIVOT) of it is dropped when `negative[k]` (an edge), and is an
     /// error otherwise; each pivot must have the sign `negative` gives it. With two
     /// `threads` or more, two independent runs of subtrees the plan chose are factored
     /// at once; each front's arithmetic is the same, so the factor is the same bit for
@@ -390,7 +388,7 @@ impl SupernodalFactor {
         scale: &[f64],
         negative: &[bool],
         threads: usize,
-    ) -> Result<(), BadPivot> {
+    ) -> Result<(), SingularPivot> {
         let n = plan.n;
         self.panels.resize(*plan.panel.last().unwrap_or(&0), 0.0);
         self.diagonal.clear();
@@ -473,7 +471,7 @@ impl Fronts {
         panels: &mut [f64],
         base: usize,
         diagonal: &mut [f64],
-    ) -> Result<(), BadPivot> {
+    ) -> Result<(), SingularPivot> {
         let Values {
             value,
             scale,
@@ -505,15 +503,16 @@ impl Fronts {
             for c in 0..w {
                 let j = f + c;
                 let d = front[c + c * m];
-                let wrong_sign = if negative[j] { d >= 0.0 } else { d <= 0.0 };
-                if negative[j] && (d.abs() <= DEPENDENT_PIVOT * scale[j] || wrong_sign) {
-                    // Dependent: its multiplier is zero, and later rows see no coupling.
-                    diagonal[j] = f64::NEG_INFINITY;
-                    self.dropped += 1;
-                    front[c + 1 + c * m..(c + 1) * m].fill(0.0);
-                    continue;
-                } else if wrong_sign || !d.is_finite() {
-                    return Err(BadPivot { unknown: j });
+                match quasi_definite(d, scale[j], negative[j]) {
+                    Pivot::Drop => {
+                        // Dependent: its multiplier is zero, and later rows see no coupling.
+                        diagonal[j] = f64::NEG_INFINITY;
+                        self.dropped += 1;
+                        front[c + 1 + c * m..(c + 1) * m].fill(0.0);
+                        continue;
+                    }
+                    Pivot::Fail => return Err(SingularPivot { row: j }),
+                    Pivot::Keep => {}
                 }
                 diagonal[j] = d;
                 let (done, rest) = front.split_at_mut((c + 1) * m);
@@ -606,7 +605,7 @@ fn extend_add(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constraints::ldl::LdlFactor;
+    use crate::linalg::symbolic::LdlFactor;
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
 
@@ -735,7 +734,7 @@ mod tests {
         let plan = SupernodalPlan::new(&p);
         let error =
             SupernodalFactor::default().factor(&plan, &[1.0, -1.0], &[1.0; 2], &[false; 2], 1);
-        assert_eq!(error, Err(BadPivot { unknown: 1 }));
+        assert_eq!(error, Err(SingularPivot { row: 1 }));
     }
 
     /// Two grids of `k × k` particles (two unknowns each) joined by a column of `k`

@@ -4,7 +4,8 @@
 //! edge to its first. Writing `A = T + u vᵀ`, with `T` tridiagonal, costs two Thomas
 //! solves (`T y = b`, `T z = u`) and one correction.
 
-use super::tridiagonal::{SingularPivot, TridiagonalFactor};
+use super::SingularPivot;
+use super::tridiagonal::TridiagonalFactor;
 
 /// A factored cyclic tridiagonal matrix, to solve many right-hand sides cheaply.
 #[derive(Clone, Debug, Default)]
@@ -86,7 +87,7 @@ pub fn solve_cyclic_tridiagonal(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constraints::tridiagonal::tests::dense_solve;
+    use crate::linalg::tridiagonal::tests::dense_solve;
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
 

@@ -5,13 +5,7 @@
 //! pivot that is not positive-finite relative to its row reports the system singular
 //! instead of returning garbage.
 
-/// A zero or non-finite pivot met at `row`: the system is singular (for example, an
-/// edge of zero length, whose constraint has no direction).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SingularPivot {
-    /// The row where elimination broke down.
-    pub row: usize,
-}
+use super::pivot::{SingularPivot, usable};
 
 /// Solve `A x = rhs` for tridiagonal `A`, overwriting `rhs` with `x`.
 ///
@@ -264,10 +258,6 @@ impl Chains {
 }
 
 /// Whether a pivot is usable: finite and not negligible against its row.
-fn usable(pivot: f64, scale: f64) -> bool {
-    pivot.abs() > 1e-14 * scale && pivot.abs() < f64::INFINITY
-}
-
 /// The row at which [`solve_tridiagonal`]'s elimination broke down: its pivots again,
 /// in its order, without the right-hand side.
 fn first_singular_row(lower: &[f64], diagonal: &[f64], upper: &[f64]) -> SingularPivot {

@@ -15,10 +15,7 @@
 use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
 
-use super::tridiagonal::SingularPivot;
-
-/// A pivot below this fraction of its original diagonal marks a dependent constraint.
-const DEPENDENT_PIVOT: f64 = 1e-10;
+use super::pivot::{Pivot, SingularPivot, positive_definite};
 
 /// The elimination order, filled pattern and update list of a symmetric sparse matrix.
 ///
@@ -187,14 +184,15 @@ impl SparseFactor {
         for j in 0..n {
             let pivot = self.values[j];
             let slots = plan.slots(j);
-            if !pivot.is_finite() {
-                return Err(SingularPivot { row: j });
-            }
-            if pivot <= DEPENDENT_PIVOT * self.inverse_pivot[j].abs() || pivot <= 0.0 {
-                self.inverse_pivot[j] = 0.0;
-                self.values[n + slots.start..n + slots.end].fill(0.0);
-                self.dropped += 1;
-                continue;
+            match positive_definite(pivot, self.inverse_pivot[j].abs()) {
+                Pivot::Fail => return Err(SingularPivot { row: j }),
+                Pivot::Drop => {
+                    self.inverse_pivot[j] = 0.0;
+                    self.values[n + slots.start..n + slots.end].fill(0.0);
+                    self.dropped += 1;
+                    continue;
+                }
+                Pivot::Keep => {}
             }
             self.inverse_pivot[j] = 1.0 / pivot;
             for value in &mut self.values[n + slots.start..n + slots.end] {
