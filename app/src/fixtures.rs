@@ -4,7 +4,7 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 use bevy_strands::collision::plugin::{account_collisions, impulses, proximity};
-use bevy_strands::contact_loop::contact_loop;
+use bevy_strands::contact::plugin::contact_loop;
 use bevy_strands::prelude::*;
 
 use crate::scenes::ScenesPlugin;

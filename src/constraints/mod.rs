@@ -11,7 +11,6 @@
 pub mod graph;
 pub mod island_edge;
 pub mod islands;
-pub mod joint_groups;
 pub mod plugin;
 pub mod projection;
 pub mod relaxation;

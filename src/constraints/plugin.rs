@@ -4,13 +4,9 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
-mod active_rows;
-mod joint_driver;
-
 use super::islands::{IslandKind, IslandSet, find_islands};
 use super::projection::{
-    Bodies, Chain, ContactRow, Graph, IslandScratch, IslandView, JointOutcome, JointSettings,
-    ProjectionSettings, RowImpulse, project_island,
+    Bodies, Chain, Graph, IslandScratch, IslandView, ProjectionSettings, project_island,
 };
 use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
@@ -21,8 +17,6 @@ use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
 use crate::world::state::ParticleState;
 use crate::world::topology::{Topology, rebuild_topology};
-use active_rows::ActiveRows;
-use joint_driver::JointDriver;
 
 /// The islands of the current topology and the solver's reusable buffers.
 #[derive(Resource, Default, Debug)]
@@ -38,8 +32,6 @@ pub struct Islands {
     pub unsolved: Vec<usize>,
     scratch: IslandScratch,
     relaxation: RelaxationScratch,
-    joint: JointDriver,
-    active: ActiveRows,
     lanes: Vec<Lane>,
     /// Each topology edge's impulse this step, summed over every projection of the
     /// step (mass × length, tension positive): see [`Islands::edge_tension`].
@@ -214,47 +206,10 @@ impl Islands {
         project_met(view, bodies, dt, settings, scratch, stats, impulse)
     }
 
-    /// Project jointly every island that `rows` touch, and the loose free particles
-    /// they touch, with the rows: both sides of every contact move, each island as a
-    /// whole (see [`project_jointly`](super::projection::project_jointly)), each
-    /// independent group on its own and on up to `threads` threads. `island` gives each
-    /// particle's island, as [`Topology::island`] does; `impulses[c]` is row c's warm
-    /// start on entry and its total impulse on return. `outcomes` tells, for each
-    /// island projected, whether it met its edges. With `acting: Some(margin)` only the
-    /// rows that act are projected: those warm-started or within `margin` (a distance
-    /// over the step) of their target at the start, their neighbours, and any the
-    /// projection leaves short (then projected again from the same start) — for islands
-    /// the Constrain stage has just met, where most rows within reach never push; a row
-    /// left out ends with no impulse. `None`: every row.
-    #[allow(clippy::too_many_arguments)]
-    pub fn project_jointly(
-        &mut self,
-        island: &[u32],
-        bodies: &mut Bodies,
-        rows: &[ContactRow],
-        impulses: &mut [RowImpulse],
-        dt: f64,
-        settings: &JointSettings,
-        stats: &mut IterationStats,
-        outcomes: &mut Vec<(u32, bool)>,
-        threads: usize,
-        acting: Option<f64>,
-    ) -> JointOutcome {
-        self.active.project(
-            &mut self.joint,
-            &self.set,
-            island,
-            bodies,
-            rows,
-            impulses,
-            dt,
-            settings,
-            threads,
-            stats,
-            outcomes,
-            &mut self.impulse,
-            acting,
-        )
+    /// What the contact solve needs of the islands: the islands, and each topology
+    /// edge's impulse this step to add its projections' to.
+    pub(crate) fn contact_parts(&mut self) -> (&IslandSet, &mut [f64]) {
+        (&self.set, &mut self.impulse)
     }
 
     /// Forget the last step's impulses (sized to the topology at its rebuild).
@@ -374,8 +329,6 @@ pub fn rebuild_islands(
         }
     }
     islands.scratch.reserve(longest, most_particles);
-    let (count, particles) = (set.islands.len(), topology.pinned.len());
-    islands.joint.reserve(count, particles);
     islands.relaxation.reserve(topology.pinned.len(), longest);
     topology.island.clear();
     topology.island.resize(topology.pinned.len(), NO_ISLAND);

@@ -7,10 +7,9 @@ use bevy::math::DVec2;
 use bevy::prelude::*;
 
 use crate::collision::broad_phase::BroadPhaseMethod;
-use crate::constraints::projection::{
-    ConstraintDirection, ContactSolver, MAX_RESTEP_DEPTH, ProjectionSettings,
-};
+use crate::constraints::projection::{ConstraintDirection, MAX_RESTEP_DEPTH, ProjectionSettings};
 use crate::constraints::solver::SolverKind;
+use crate::contact::settings::ContactSolver;
 use crate::model::validate::{
     NumberError, at_least, finite_vector, non_negative, positive, within,
 };

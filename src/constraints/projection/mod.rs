@@ -24,44 +24,30 @@
 //! end-of-step direction has no such limit.
 //!
 //! **Contacts.** The islands that contact rows touch are projected together with
-//! those rows by [`project_jointly`] (`joint`, `joint_rows`): every island's edges met
-//! exactly, the rows to a tolerance, both sides of each contact moving.
+//! those rows by [`crate::contact`], which walks their edges with this module's
+//! [`walk`]s and factors them with its [`scratch`]'s factors.
 //!
-//! A pure kernel: slices in, slices out, no allocation once the scratch is sized. The
-//! loop is in `newton`, the assembly and solve of the system in `assembly`.
+//! A pure kernel: slices in, slices out, no allocation once the scratch is sized. One
+//! projection is in `project`, its Newton iterations in `iterate` (shared with each
+//! substep of a re-stepped one, `restep`), the assembly and solve of the system in
+//! `assembly`.
 
 mod assembly;
-mod contact_cone;
-mod contact_kkt;
-mod contact_line;
-mod contact_newton;
-mod contact_rows;
-mod contact_scratch;
 mod iterate;
-mod joint;
-mod joint_row;
-mod joint_rows;
-mod joint_split;
-mod joint_state;
-mod newton;
+mod project;
 mod restep;
-mod scratch;
+pub(crate) mod scratch;
 mod settings;
-mod view;
-mod walk;
+pub(crate) mod view;
+pub(crate) mod walk;
 
-pub use contact_rows::{ContactRow, RowImpulse};
-pub use joint::project_jointly;
-pub use joint_split::CUT_ROWS as JOINT_CUT_ROWS;
-pub use joint_state::JointScratch;
 pub use scratch::IslandScratch;
 pub use settings::{
-    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, MAX_RESTEP_DEPTH,
-    ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR, Resting,
+    ConstraintDirection, MAX_RESTEP_DEPTH, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
 };
 pub use view::{Bodies, Chain, Graph, IslandView};
 
-use newton::project_walk;
+use project::project_walk;
 use walk::{ChainWalk, GraphWalk};
 
 /// Project the velocities of one chain so that every edge ends the step at its rest

@@ -11,27 +11,27 @@ use crate::linalg::tridiagonal::TridiagonalFactor;
 /// [`IslandScratch::reserve`].
 #[derive(Clone, Debug, Default)]
 pub struct IslandScratch {
-    pub(super) correction: Vec<DVec2>,
-    pub(super) inverse_mass: Vec<f64>,
-    pub(super) locked: Vec<bool>,
-    pub(super) predicted_edge: Vec<DVec2>,
-    pub(super) edge: Vec<DVec2>,
-    pub(super) start_direction: Vec<DVec2>,
-    pub(super) constraint: Vec<f64>,
-    pub(super) lower: Vec<f64>,
-    pub(super) diagonal: Vec<f64>,
-    pub(super) upper: Vec<f64>,
-    pub(super) rhs: Vec<f64>,
-    pub(super) thomas: Vec<f64>,
+    pub(crate) correction: Vec<DVec2>,
+    pub(crate) inverse_mass: Vec<f64>,
+    pub(crate) locked: Vec<bool>,
+    pub(crate) predicted_edge: Vec<DVec2>,
+    pub(crate) edge: Vec<DVec2>,
+    pub(crate) start_direction: Vec<DVec2>,
+    pub(crate) constraint: Vec<f64>,
+    pub(crate) lower: Vec<f64>,
+    pub(crate) diagonal: Vec<f64>,
+    pub(crate) upper: Vec<f64>,
+    pub(crate) rhs: Vec<f64>,
+    pub(crate) thomas: Vec<f64>,
     /// Each edge's impulse this projection (mass × length, tension positive): the sum of
     /// its Newton steps' `−2 λ |d|`.
-    pub(super) edge_impulse: Vec<f64>,
-    pub(super) factors: Factors,
+    pub(crate) edge_impulse: Vec<f64>,
+    pub(crate) factors: Factors,
     /// Re-stepping (`restep`): each particle's offset from its start of step and its
     /// velocity in the current substep, and each edge's impulse scaled to the step.
-    pub(super) substep_offset: Vec<DVec2>,
-    pub(super) substep_velocity: Vec<DVec2>,
-    pub(super) substep_impulse: Vec<f64>,
+    pub(crate) substep_offset: Vec<DVec2>,
+    pub(crate) substep_velocity: Vec<DVec2>,
+    pub(crate) substep_impulse: Vec<f64>,
 }
 
 impl IslandScratch {
@@ -58,7 +58,7 @@ impl IslandScratch {
     }
 
     /// Make room for re-stepping an island of `edges` edges among `particles`.
-    pub(super) fn reserve_substeps(&mut self, edges: usize, particles: usize) {
+    pub(crate) fn reserve_substeps(&mut self, edges: usize, particles: usize) {
         grow(&mut self.substep_offset, particles, DVec2::ZERO);
         grow(&mut self.substep_velocity, particles, DVec2::ZERO);
         grow(&mut self.substep_impulse, edges, 0.0);
@@ -79,8 +79,8 @@ fn grow<T: Clone>(buffer: &mut Vec<T>, n: usize, value: T) {
 
 /// The factors an island's system may be kept in between solves.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Factors {
-    pub(super) open: TridiagonalFactor,
-    pub(super) cyclic: CyclicFactor,
-    pub(super) sparse: SparseFactor,
+pub(crate) struct Factors {
+    pub(crate) open: TridiagonalFactor,
+    pub(crate) cyclic: CyclicFactor,
+    pub(crate) sparse: SparseFactor,
 }

@@ -10,7 +10,7 @@ use crate::constraints::island_edge::IslandEdge;
 use crate::linalg::SingularPivot;
 
 /// An island's particles, edges and system.
-pub(super) trait Walk: Copy {
+pub(crate) trait Walk: Copy {
     /// Particles of the island of `edges`.
     fn particles(self, edges: &[IslandEdge]) -> usize;
     /// Packed index of local particle `j`.
@@ -37,8 +37,8 @@ pub(super) trait Walk: Copy {
 
 /// A path or a loop.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct ChainWalk {
-    pub(super) closed: bool,
+pub(crate) struct ChainWalk {
+    pub(crate) closed: bool,
 }
 
 impl Walk for ChainWalk {
@@ -96,8 +96,8 @@ impl Walk for ChainWalk {
 
 /// A tree or a graph.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct GraphWalk<'a> {
-    pub(super) layout: &'a GraphLayout,
+pub(crate) struct GraphWalk<'a> {
+    pub(crate) layout: &'a GraphLayout,
 }
 
 impl Walk for GraphWalk<'_> {

@@ -29,17 +29,23 @@
 //! round-off at every step. Once the rows are met and the edges nearly so, the joint
 //! projection's last Newton steps polish the edges alone (`joint`).
 
+mod cone;
+mod kkt;
+mod line_search;
+pub(super) mod scratch;
+
 use bevy::math::DVec2;
 
-use super::contact_cone::{
+use self::cone::{
     cone, edges, impulse, pull, push, row_motion, row_values, unknown_motion, unknown_vector,
 };
-use super::contact_kkt::{KktInput, NONE, RowModel};
-use super::contact_line::Line;
-use super::contact_scratch::NewtonScratch;
-use super::joint_row::JointRow;
-use super::joint_state::{JointScratch, measure_edges};
-use super::settings::{ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR};
+use self::kkt::{KktInput, NONE, RowModel};
+use self::line_search::Line;
+use self::scratch::NewtonScratch;
+use crate::constraints::projection::ROUND_OFF_FLOOR;
+use crate::contact::local_row::LocalRow;
+use crate::contact::scratch::{ContactScratch, measure_edges};
+use crate::contact::settings::{ContactOutcome, ContactSettings, ContactSolver};
 
 /// A row's contact stiffness over its own mass `1 / Σ cᵢ² wᵢ`: soft enough that a step
 /// pressing a new row is not stopped at it, stiff enough that a row pressed by impulse
@@ -60,7 +66,7 @@ const CLOSE_ENOUGH: f64 = 4.0;
 
 /// Row `r`'s cone values at corrections `delta`, shifted by its impulses and with its
 /// normal value lifted by what its sliding asked of it last time (see [`run`]).
-fn cone_values(row: &JointRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> [f64; 2] {
+fn cone_values(row: &LocalRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> [f64; 2] {
     let (un, ut) = row_values(row, delta);
     let un = un + w.lift[r];
     let e = cone(row.friction);
@@ -72,9 +78,9 @@ fn cone_values(row: &JointRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> 
 /// impulses hold the result. Returns whether the rows were met, or `None`, touching
 /// nothing, when the sweeps would cost less (see [`prefers_sweeps`]).
 pub(super) fn solve(
-    settings: &JointSettings,
-    s: &mut JointScratch,
-    outcome: &mut JointOutcome,
+    settings: &ContactSettings,
+    s: &mut ContactScratch,
+    outcome: &mut ContactOutcome,
 ) -> Option<bool> {
     let mut newton = std::mem::take(&mut s.newton);
     let met = run(settings, s, &mut newton, outcome);
@@ -98,7 +104,7 @@ fn prefers_sweeps(responses: f64, work: f64) -> bool {
 }
 
 /// The particles of every row's responses: what a sweep over the rows writes.
-fn responses(s: &JointScratch) -> f64 {
+fn responses(s: &ContactScratch) -> f64 {
     s.rows
         .iter()
         .flat_map(|row| &row.links[..row.link_count as usize])
@@ -127,7 +133,7 @@ const SWEPT_MASS_SPREAD: f64 = 100.0;
 /// faster.
 const SHORT_RESPONSES: f64 = 48.0;
 
-fn kkt_input<'a>(s: &'a JointScratch, included: &'a [bool]) -> KktInput<'a> {
+fn kkt_input<'a>(s: &'a ContactScratch, included: &'a [bool]) -> KktInput<'a> {
     KktInput {
         inverse_mass: &s.inverse_mass,
         included,
@@ -140,10 +146,10 @@ fn kkt_input<'a>(s: &'a JointScratch, included: &'a [bool]) -> KktInput<'a> {
 }
 
 fn run(
-    settings: &JointSettings,
-    s: &mut JointScratch,
+    settings: &ContactSettings,
+    s: &mut ContactScratch,
     w: &mut NewtonScratch,
-    outcome: &mut JointOutcome,
+    outcome: &mut ContactOutcome,
 ) -> Option<bool> {
     let n = s.packed.len();
     let rows = s.rows.len();
@@ -374,7 +380,7 @@ fn run(
 }
 
 /// A row's warm cone impulses from its (normal, tangent) warm start, inside the cone.
-fn warm_lambda(row: &JointRow) -> [f64; 2] {
+fn warm_lambda(row: &LocalRow) -> [f64; 2] {
     let normal = row.mu_n.max(0.0);
     if row.friction <= 0.0 {
         return [normal, 0.0];
@@ -389,7 +395,7 @@ fn warm_lambda(row: &JointRow) -> [f64; 2] {
 /// stopped before it (the step would have pressed it), or if the model pressed it and
 /// it still pushes without being clear (the model leaves it at −λ/k, zero where λ is);
 /// on the first step, every edge with a warm impulse.
-fn choose_model(s: &JointScratch, w: &mut NewtonScratch, first: bool, renewed: bool) {
+fn choose_model(s: &ContactScratch, w: &mut NewtonScratch, first: bool, renewed: bool) {
     w.value.clear();
     for (r, row) in s.rows.iter().enumerate() {
         let k = w.stiffness[r];
@@ -431,7 +437,7 @@ fn choose_model(s: &JointScratch, w: &mut NewtonScratch, first: bool, renewed: b
 }
 
 /// The rows' shifted cone values at the current corrections, into `w.value`.
-fn shifted_values(s: &JointScratch, w: &mut NewtonScratch) {
+fn shifted_values(s: &ContactScratch, w: &mut NewtonScratch) {
     w.value.clear();
     for (r, row) in s.rows.iter().enumerate() {
         let values = cone_values(row, r, w, &s.correction);
@@ -441,7 +447,7 @@ fn shifted_values(s: &JointScratch, w: &mut NewtonScratch) {
 
 /// The right-hand sides: the full step (the objective's forces at the iterate) and
 /// the step that only meets the edges.
-fn right_hand_sides(s: &JointScratch, w: &mut NewtonScratch, unknowns: usize) {
+fn right_hand_sides(s: &ContactScratch, w: &mut NewtonScratch, unknowns: usize) {
     w.full.clear();
     w.full.resize(unknowns, 0.0);
     w.feasible.clear();
@@ -494,7 +500,7 @@ fn edge_force(w: &NewtonScratch, r: usize, x: usize) -> f64 {
 /// rows' impulses as the model moves them there) in `w.start`, and the way from there
 /// to the full step's end in `w.step`, as particle impulses, cone impulses and edge
 /// tensions, each a sum of equal and opposite impulses.
-fn lines(s: &JointScratch, w: &mut NewtonScratch) {
+fn lines(s: &ContactScratch, w: &mut NewtonScratch) {
     let n = s.packed.len();
     w.start.clear();
     w.start.extend_from_slice(&w.momentum);
@@ -559,7 +565,7 @@ fn lines(s: &JointScratch, w: &mut NewtonScratch) {
 /// Whether the rows at the iterate are as the model held them: pressed cone edges
 /// still pushing, the others clear (within a thousandth of the tolerance, so that an
 /// edge at the border of both may be taken for either).
-fn model_holds(s: &JointScratch, w: &NewtonScratch, tolerance: f64) -> bool {
+fn model_holds(s: &ContactScratch, w: &NewtonScratch, tolerance: f64) -> bool {
     let slack = 1e-3 * tolerance;
     s.rows.iter().enumerate().all(|(r, row)| {
         let k = w.stiffness[r];
@@ -581,7 +587,7 @@ fn model_holds(s: &JointScratch, w: &NewtonScratch, tolerance: f64) -> bool {
 
 /// Whether no cone edge pulls by more than an impulse that moves its row's own mass by
 /// `distance`.
-fn pull_at_most(s: &JointScratch, w: &NewtonScratch, distance: f64) -> bool {
+fn pull_at_most(s: &ContactScratch, w: &NewtonScratch, distance: f64) -> bool {
     (0..s.rows.len()).all(|r| {
         let own = w.stiffness[r] / STIFFNESS;
         w.lambda[r].iter().all(|&l| l >= -own * distance)
@@ -591,7 +597,7 @@ fn pull_at_most(s: &JointScratch, w: &NewtonScratch, distance: f64) -> bool {
 /// How far (a distance per step) the rows are from Coulomb's law at the iterate: a row
 /// short of its target, a pressed one clear of it (the convex cone lifts a sliding
 /// contact by μ times its sliding), a sticking one sliding.
-fn violation(s: &JointScratch, w: &NewtonScratch) -> f64 {
+fn violation(s: &ContactScratch, w: &NewtonScratch) -> f64 {
     let mut worst = 0.0f64;
     for (r, row) in s.rows.iter().enumerate() {
         if w.stiffness[r] == 0.0 {
@@ -611,7 +617,7 @@ fn violation(s: &JointScratch, w: &NewtonScratch) -> f64 {
 }
 
 /// `s.correction = W p` (fixed particles stay).
-fn set_correction(s: &mut JointScratch, p: &[DVec2]) {
+fn set_correction(s: &mut ContactScratch, p: &[DVec2]) {
     for ((c, &w), p) in s.correction.iter_mut().zip(&s.inverse_mass).zip(p) {
         *c = w * *p;
     }

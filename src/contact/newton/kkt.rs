@@ -13,7 +13,7 @@
 
 use bevy::math::DVec2;
 
-use super::joint_row::JointRow;
+use crate::contact::local_row::LocalRow;
 use crate::linalg::SingularPivot;
 use crate::linalg::supernodal::{SupernodalFactor, SupernodalPlan};
 use crate::linalg::symbolic::LdlPattern;
@@ -29,7 +29,7 @@ pub(super) struct KktInput<'a> {
     pub(super) locked: &'a [bool],
     pub(super) incident: &'a [(u32, f64)],
     pub(super) incident_start: &'a [u32],
-    pub(super) rows: &'a [JointRow],
+    pub(super) rows: &'a [LocalRow],
     /// Which rows the system may press: the others have no room in its pattern.
     pub(super) included: &'a [bool],
 }

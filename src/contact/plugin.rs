@@ -3,7 +3,7 @@
 //!
 //! Before any impulse, the contact solve (the Speculate sub-stage) turns every pair
 //! within reach into a contact row and projects the islands they touch jointly with
-//! them (`constraints::projection::project_jointly`): the rows keep pairs a cushion
+//! them (`constraints::projection::project_with_contacts`): the rows keep pairs a cushion
 //! apart, with friction, and every edge stays exact. Continuous detection then
 //! verifies the step; what the rows' linearization missed gets collision impulses.
 //! After impulses, the islands they touched are projected again jointly, with every
@@ -15,17 +15,21 @@
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use super::active_set::ActiveRows;
+use super::driver::GroupDriver;
+use super::rows::{ContactRow, RowImpulse};
+use super::settings::{ContactOutcome, ContactSettings, Resting};
+use super::speculative::{SpeculationScratch, SpeculationSettings, speculative_rows};
 use crate::collision::CollisionScratch;
 use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
 use crate::constraints::Islands;
-use crate::constraints::projection::{Bodies, ContactRow, JointSettings, Resting, RowImpulse};
-use crate::metrics::StrandMetrics;
+use crate::constraints::projection::Bodies;
+use crate::metrics::{IterationStats, StrandMetrics};
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
 use crate::rollback::RollbackApp;
 use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
-use crate::speculation::{SpeculationScratch, SpeculationSettings, speculative_rows};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
 use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::topology::Topology;
@@ -70,14 +74,14 @@ impl Plugin for ContactLoopPlugin {
 /// strands apart), the contact loop's reprojection sooner (1/2: its rows come after a
 /// detected crossing, and the fail-safe is there when they cannot hold). Measured in
 /// docs/step-size.md: either share alone leaves more fail-safe steps at 1/120.
-fn joint_settings(
+fn contact_settings(
     contact: &ContactConfig,
     collisions: &CollisionConfig,
     constraints: &ConstraintConfig,
     dt: f64,
     give_way: (u32, u32),
-) -> JointSettings {
-    JointSettings {
+) -> ContactSettings {
+    ContactSettings {
         resting: None,
         projection: constraints.projection(),
         sweeps: contact.sweeps,
@@ -115,6 +119,69 @@ pub struct ContactRows {
     warm: Vec<(u32, u32, RowImpulse)>,
     /// The topology version the warm starts belong to.
     warm_version: u64,
+    /// Which rows act, round by round, and the groups they join.
+    solve: GroupSolve,
+}
+
+/// The active set's rounds and the driver of the groups they project, sized for the
+/// islands of one topology version.
+#[derive(Default, Debug)]
+struct GroupSolve {
+    active: ActiveRows,
+    driver: GroupDriver,
+    version: Option<u64>,
+}
+
+impl GroupSolve {
+    /// Project every island that `rows` touch, and the loose free particles
+    /// they touch, with the rows: both sides of every contact move, each island as a
+    /// whole (see [`project_with_contacts`](super::projection::project_with_contacts)), each
+    /// independent group on its own and on up to `threads` threads. `island` gives each
+    /// particle's island, as [`Topology::island`] does; `impulses[c]` is row c's warm
+    /// start on entry and its total impulse on return. `outcomes` tells, for each
+    /// island projected, whether it met its edges. With `acting: Some(margin)` only the
+    /// rows that act are projected: those warm-started or within `margin` (a distance
+    /// over the step) of their target at the start, their neighbours, and any the
+    /// projection leaves short (then projected again from the same start) — for islands
+    /// the Constrain stage has just met, where most rows within reach never push; a row
+    /// left out ends with no impulse. `None`: every row.
+    #[allow(clippy::too_many_arguments)]
+    fn project(
+        &mut self,
+        islands: &mut Islands,
+        island: &[u32],
+        bodies: &mut Bodies,
+        rows: &[ContactRow],
+        impulses: &mut [RowImpulse],
+        dt: f64,
+        settings: &ContactSettings,
+        stats: &mut IterationStats,
+        outcomes: &mut Vec<(u32, bool)>,
+        threads: usize,
+        acting: Option<f64>,
+    ) -> ContactOutcome {
+        let version = islands.version;
+        let (set, edge_impulse) = islands.contact_parts();
+        if self.version != Some(version) {
+            self.driver.reserve(set.islands.len(), island.len());
+            self.version = Some(version);
+        }
+        self.active.project(
+            &mut self.driver,
+            set,
+            island,
+            bodies,
+            rows,
+            impulses,
+            dt,
+            settings,
+            threads,
+            stats,
+            outcomes,
+            edge_impulse,
+            acting,
+        )
+    }
 }
 
 impl ContactRows {
@@ -148,7 +215,7 @@ pub fn speculate(
     if !speculating(&collisions, &contact, &constraints) {
         return;
     }
-    let settings = JointSettings {
+    let settings = ContactSettings {
         // Groups at rest are met closely (the sweeps' residue keeps a pile trembling).
         resting: Some(Resting {
             speed: step.sleep.speed,
@@ -156,7 +223,7 @@ pub fn speculate(
             sweeps: contact.rest_sweeps,
             tolerance: contact.rest_tolerance * collisions.thickness * step.dt,
         }),
-        ..joint_settings(&contact, &collisions, &constraints, step.dt, (9, 10))
+        ..contact_settings(&contact, &collisions, &constraints, step.dt, (9, 10))
     };
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let thickness = collisions.thickness;
@@ -205,7 +272,8 @@ pub fn speculate(
         return;
     }
     let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
-    islands.project_jointly(
+    buffers.solve.project(
+        &mut islands,
         collider.groups,
         &mut bodies,
         &buffers.rows,
@@ -285,7 +353,7 @@ pub fn contact_loop(
     if !(collisions.enabled && constraints.solver.projects_contacts() && contact.passes > 0) {
         return;
     }
-    let settings = joint_settings(&contact, &collisions, &constraints, step.dt, (1, 2));
+    let settings = contact_settings(&contact, &collisions, &constraints, step.dt, (1, 2));
     let impulse_settings = collisions.impulse_settings(step.worker_threads());
     let scratch = &mut *scratch;
     let mut changed = scratch.outcome.impulses > 0;
@@ -328,11 +396,11 @@ fn reproject(
     collider: &mut Collider,
     contact: &ContactConfig,
     islands: &mut Islands,
-    settings: &JointSettings,
+    settings: &ContactSettings,
     buffers: &mut ContactRows,
     metrics: &mut StrandMetrics,
 ) {
-    let (rows, impulses) = (&mut buffers.rows, &mut buffers.impulses);
+    let (rows, impulses, solve) = (&mut buffers.rows, &mut buffers.impulses, &mut buffers.solve);
     // Rows: every contact met this step, and every pair already closer than `reach`
     // thicknesses. Each may approach while it ends the step at least `keep` of the
     // thickness apart.
@@ -374,7 +442,8 @@ fn reproject(
     impulses.clear();
     impulses.resize(rows.len(), RowImpulse::default());
     let mut bodies = Bodies::new(collider.position, collider.velocity, collider.inverse_mass);
-    islands.project_jointly(
+    solve.project(
+        islands,
         collider.groups,
         &mut bodies,
         rows,

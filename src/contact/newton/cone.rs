@@ -4,8 +4,8 @@
 
 use bevy::math::DVec2;
 
-use super::contact_kkt::NONE;
-use super::joint_row::JointRow;
+use super::kkt::NONE;
+use crate::contact::local_row::LocalRow;
 
 /// The edges of a row's cone in its (normal, tangent) plane; without friction one
 /// edge, the normal (the second is then unused).
@@ -20,12 +20,12 @@ pub(super) fn edges(friction: f64) -> usize {
 }
 
 /// `Σ cᵢ d·vᵢ` along the row's normal and tangent.
-pub(super) fn row_motion(row: &JointRow, v: &[DVec2]) -> (f64, f64) {
+pub(super) fn row_motion(row: &LocalRow, v: &[DVec2]) -> (f64, f64) {
     motion_of(row, |j| v[j as usize])
 }
 
 /// `Σ cᵢ d·vᵢ` along the row's normal and tangent, with `v(j)` particle j's motion.
-fn motion_of(row: &JointRow, v: impl Fn(u32) -> DVec2) -> (f64, f64) {
+fn motion_of(row: &LocalRow, v: impl Fn(u32) -> DVec2) -> (f64, f64) {
     let (n, t) = (row.normal, row.normal.perp());
     let (mut a, mut b) = (0.0, 0.0);
     for &(j, c) in &row.entries[..row.count as usize] {
@@ -37,13 +37,13 @@ fn motion_of(row: &JointRow, v: impl Fn(u32) -> DVec2) -> (f64, f64) {
 }
 
 /// A row's normal and tangent values `slack + Σ cᵢ d·Δᵢ` for corrections `delta`.
-pub(super) fn row_values(row: &JointRow, delta: &[DVec2]) -> (f64, f64) {
+pub(super) fn row_values(row: &LocalRow, delta: &[DVec2]) -> (f64, f64) {
     let (a, b) = row_motion(row, delta);
     (row.slack_n + a, row.slack_t + b)
 }
 
 /// A row's motion along its normal and tangent for the particle unknowns in `x`.
-pub(super) fn unknown_motion(row: &JointRow, particle_unknown: &[u32], x: &[f64]) -> (f64, f64) {
+pub(super) fn unknown_motion(row: &LocalRow, particle_unknown: &[u32], x: &[f64]) -> (f64, f64) {
     motion_of(row, |j| unknown_vector(particle_unknown, x, j))
 }
 
@@ -69,7 +69,7 @@ pub(super) fn impulse(friction: f64, lambda: [f64; 2]) -> (f64, f64) {
 }
 
 /// Add `row`'s impulse `(normal, tangent)` to the particles' impulses `p`.
-pub(super) fn push(row: &JointRow, impulse: (f64, f64), p: &mut [DVec2]) {
+pub(super) fn push(row: &LocalRow, impulse: (f64, f64), p: &mut [DVec2]) {
     let direction = impulse.0 * row.normal + impulse.1 * row.normal.perp();
     for &(j, c) in &row.entries[..row.count as usize] {
         p[j as usize] += c * direction;

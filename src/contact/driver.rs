@@ -1,5 +1,5 @@
 //! Driving the joint projection of islands in contact: which islands and loose
-//! particles the rows touch, their independent groups ([`JointGroups`]), and each group
+//! particles the rows touch, their independent groups ([`ContactGroups`]), and each group
 //! projected on its own — on several threads when there are enough rows. A group
 //! reads and writes only its own particles (the rows' other particles are pinned or
 //! driven), so the result is the same bit for bit whatever the thread count.
@@ -8,12 +8,14 @@ use std::ops::Range;
 
 use bevy::math::DVec2;
 
+use super::groups::{ContactGroups, NONE, RowSlots};
+use super::projection::project_with_contacts;
+use super::rows::{ContactRow, RowImpulse};
+use super::scratch::ContactScratch;
+use super::settings::{ContactOutcome, ContactSettings};
+use super::split::CUT_ROWS;
 use crate::constraints::islands::IslandSet;
-use crate::constraints::joint_groups::{JointGroups, NONE, RowSlots};
-use crate::constraints::projection::{
-    Bodies, ContactRow, JOINT_CUT_ROWS, JointOutcome, JointScratch, JointSettings,
-    ProjectionOutcome, RowImpulse, project_jointly,
-};
+use crate::constraints::projection::{Bodies, ProjectionOutcome};
 use crate::metrics::IterationStats;
 use crate::model::NO_ISLAND;
 
@@ -22,14 +24,14 @@ const PARALLEL_ROWS: usize = 512;
 
 /// The buffers of joint projections, reused every step.
 #[derive(Default, Debug)]
-pub(super) struct JointDriver {
+pub(super) struct GroupDriver {
     /// Islands, then loose particles, that the current rows touch (sorted).
     islands: Vec<u32>,
     loose: Vec<u32>,
     /// Which islands (then which particles) are taken, while collecting.
     marks: Vec<bool>,
     row_slots: Vec<RowSlots>,
-    groups: JointGroups,
+    groups: ContactGroups,
     /// The first lane is the calling thread's.
     lanes: Vec<Lane>,
     /// The velocities before the lanes ran.
@@ -39,7 +41,7 @@ pub(super) struct JointDriver {
 /// One thread's groups and buffers.
 #[derive(Default, Debug)]
 struct Lane {
-    scratch: JointScratch,
+    scratch: ContactScratch,
     groups: Range<u32>,
     velocity: Vec<DVec2>,
     members: Vec<u32>,
@@ -52,7 +54,7 @@ struct Lane {
     edge_impulses: Vec<(u32, f64)>,
     outcomes: Vec<(u32, bool)>,
     stats: IterationStats,
-    total: JointOutcome,
+    total: ContactOutcome,
 }
 
 /// What every group's projection reads.
@@ -60,14 +62,14 @@ struct Shared<'a> {
     set: &'a IslandSet,
     islands: &'a [u32],
     loose: &'a [u32],
-    groups: &'a JointGroups,
+    groups: &'a ContactGroups,
     rows: &'a [ContactRow],
     impulses: &'a [RowImpulse],
     dt: f64,
-    settings: &'a JointSettings,
+    settings: &'a ContactSettings,
 }
 
-impl JointDriver {
+impl GroupDriver {
     /// Room for `islands` islands and `particles` particles.
     pub(super) fn reserve(&mut self, islands: usize, particles: usize) {
         self.islands.reserve(islands);
@@ -87,16 +89,16 @@ impl JointDriver {
         rows: &[ContactRow],
         impulses: &mut [RowImpulse],
         dt: f64,
-        settings: &JointSettings,
+        settings: &ContactSettings,
         threads: usize,
         stats: &mut IterationStats,
         outcomes: &mut Vec<(u32, bool)>,
         edge_impulse: &mut [f64],
-    ) -> JointOutcome {
+    ) -> ContactOutcome {
         outcomes.clear();
         self.collect(set.islands.len(), island, bodies, rows);
         if self.islands.is_empty() && self.loose.is_empty() {
-            return JointOutcome {
+            return ContactOutcome {
                 converged: true,
                 ..Default::default()
             };
@@ -106,7 +108,7 @@ impl JointDriver {
         // A group with most of the rows, large enough to be cut, gets the threads inside
         // its own sweeps: the groups then run one after another.
         let largest = (0..groups).map(|g| self.groups.rows_of(g).len()).max();
-        let dominant = largest.is_some_and(|r| r >= JOINT_CUT_ROWS && 2 * r > rows.len());
+        let dominant = largest.is_some_and(|r| r >= CUT_ROWS && 2 * r > rows.len());
         let lanes = if rows.len() < PARALLEL_ROWS || dominant {
             1
         } else {
@@ -121,7 +123,7 @@ impl JointDriver {
             // One group: projected in place, as it comes.
             let lane = &mut self.lanes[0];
             lane.begin();
-            let outcome = project_jointly(
+            let outcome = project_with_contacts(
                 set,
                 &self.islands,
                 &self.loose,
@@ -188,7 +190,7 @@ impl JointDriver {
             }
         }
         // Merge in group order: the same sums in the same order whatever the lanes.
-        let mut total = JointOutcome {
+        let mut total = ContactOutcome {
             converged: true,
             ..Default::default()
         };
@@ -304,7 +306,7 @@ impl Lane {
                 (self.impulses).push(shared.impulses.get(c as usize).copied().unwrap_or_default());
                 self.taken.push((c, RowImpulse::default()));
             }
-            let outcome = project_jointly(
+            let outcome = project_with_contacts(
                 shared.set,
                 &self.members,
                 &self.loose,
@@ -330,14 +332,14 @@ impl Lane {
         self.edge_impulses.clear();
         self.outcomes.clear();
         self.stats = IterationStats::default();
-        self.total = JointOutcome {
+        self.total = ContactOutcome {
             converged: true,
             ..Default::default()
         };
     }
 
     /// Keep the results of a projection of `members` (still in the scratch).
-    fn account(&mut self, set: &IslandSet, members: &[u32], outcome: &JointOutcome) {
+    fn account(&mut self, set: &IslandSet, members: &[u32], outcome: &ContactOutcome) {
         for (i, &member) in members.iter().enumerate() {
             self.outcomes.push((member, self.scratch.island_met(i)));
             let edges = &set.edges[set.islands[member as usize].edges.clone()];

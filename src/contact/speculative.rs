@@ -8,7 +8,7 @@
 
 use bevy::math::DVec2;
 
-use crate::constraints::projection::ContactRow;
+use super::rows::ContactRow;
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
 use crate::parallel::run_each;
@@ -339,7 +339,7 @@ mod tests {
     }
 
     #[test]
-    fn a_point_over_the_joint_of_a_straight_strand_gets_one_row() {
+    fn a_point_over_the_local_of_a_straight_strand_gets_one_row() {
         // Point 0 just above particle 2, where edges 1–2 and 2–3 of a flat strand meet.
         let position = vec![
             DVec2::new(0.0, 0.003),

@@ -10,7 +10,7 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::{ContactRow, RowImpulse};
+use super::rows::{ContactRow, RowImpulse};
 use crate::constraints::islands::IslandSet;
 
 /// A joint projection with fewer rows than this is swept as one: the cut costs a pass
@@ -32,7 +32,7 @@ const BETWEEN: u8 = 2;
 
 /// The cut of one joint projection, and its buffers.
 #[derive(Clone, Debug, Default)]
-pub(super) struct JointCut {
+pub(super) struct RowCut {
     /// The members (islands by position in the projection's list, then loose particles
     /// after them) in layout order: side 0's first.
     pub(super) members: Vec<u32>,
@@ -81,7 +81,7 @@ impl Members<'_> {
     }
 }
 
-impl JointCut {
+impl RowCut {
     /// Cut `of` and `rows` (`impulses` their warm starts).
     pub(super) fn cut(
         &mut self,
@@ -305,7 +305,7 @@ mod tests {
                 _ => row(9, 6, 7),
             });
         }
-        let mut cut = JointCut::default();
+        let mut cut = RowCut::default();
         cut.cut(
             members(&set, &islands),
             &position,
@@ -355,7 +355,7 @@ mod tests {
     fn small_problems_and_problems_with_one_side_only_are_not_cut() {
         let (set, position, inverse_mass) = four_strands();
         let islands = islands_of(&set);
-        let mut cut = JointCut::default();
+        let mut cut = RowCut::default();
         let few = vec![row(0, 3, 4); CUT_ROWS - 1];
         cut.cut(members(&set, &islands), &position, &inverse_mass, &few, &[]);
         assert_eq!(cut.row_ends, (0, 0));

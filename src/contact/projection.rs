@@ -25,25 +25,24 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::{ContactRow, RowImpulse};
-use super::joint_rows::{Sweeps, localize_rows};
-use super::joint_split::Members;
-use super::joint_state::{JointScratch, LOOSE, NOT_JOINT, Part, measure_edges};
-use super::scratch::Factors;
-use super::settings::{
-    ConstraintDirection, ContactSolver, JointOutcome, JointSettings, ROUND_OFF_FLOOR, Resting,
-};
-use super::view::{Bodies, IslandView};
-use super::walk::{ChainWalk, GraphWalk, Walk};
+use super::rows::{ContactRow, RowImpulse};
+use super::scratch::{ContactScratch, LOOSE, NOT_LOCAL, Part, measure_edges};
+use super::settings::{ContactOutcome, ContactSettings, ContactSolver, Resting};
+use super::split::Members;
+use super::sweeps::{Sweeps, localize_rows};
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::islands::IslandSet;
+use crate::constraints::projection::scratch::Factors;
+use crate::constraints::projection::view::{Bodies, IslandView};
+use crate::constraints::projection::walk::{ChainWalk, GraphWalk, Walk};
+use crate::constraints::projection::{ConstraintDirection, ROUND_OFF_FLOOR};
 
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
 /// polished alone (if what the rows fall short allows no less): the polish then moves
 /// particles by at most a few ten-thousandths of an edge. Lower, rows that have
 /// stalled keep the Newton steps going while their sweeps stir the edges back above
 /// it (the fur held at 2e-4 for ten Newton steps of 16 sweeps each).
-const JOINT_POLISH: f64 = 1e-3;
+const EDGE_POLISH: f64 = 1e-3;
 
 /// Project `islands` and the `loose` free particles jointly with `rows`: every edge of
 /// every island ends the step at its rest length, and every row is met to the contact
@@ -52,7 +51,7 @@ const JOINT_POLISH: f64 = 1e-3;
 /// return. Only free particles of the parts change velocity. Rows whose particles are
 /// all outside the parts are ignored.
 #[allow(clippy::too_many_arguments)]
-pub fn project_jointly(
+pub fn project_with_contacts(
     set: &IslandSet,
     islands: &[u32],
     loose: &[u32],
@@ -60,9 +59,9 @@ pub fn project_jointly(
     rows: &[ContactRow],
     impulses: &mut [RowImpulse],
     dt: f64,
-    settings: &JointSettings,
-    scratch: &mut JointScratch,
-) -> JointOutcome {
+    settings: &ContactSettings,
+    scratch: &mut ContactScratch,
+) -> ContactOutcome {
     let Bodies {
         position,
         velocity,
@@ -89,7 +88,7 @@ pub fn project_jointly(
     // A group at rest is met closely by the sweeps (the contact Newton meets its rows
     // to their fixed point whatever the tolerance).
     let resting = match settings.resting {
-        Some(rest) if at_rest(scratch, velocity, &rest) => Some(JointSettings {
+        Some(rest) if at_rest(scratch, velocity, &rest) => Some(ContactSettings {
             sweeps: rest.sweeps,
             contact_tolerance: rest.tolerance,
             ..*settings
@@ -128,7 +127,7 @@ pub fn project_jointly(
             };
         }
     }
-    JointOutcome {
+    ContactOutcome {
         converged: s.met.iter().all(|&m| m),
         ..outcome
     }
@@ -136,7 +135,7 @@ pub fn project_jointly(
 
 /// Whether the group laid out in `s` rests: its free particles' mean speed, less the
 /// step's fall, below `rest.speed`.
-fn at_rest(s: &JointScratch, velocity: &[DVec2], rest: &Resting) -> bool {
+fn at_rest(s: &ContactScratch, velocity: &[DVec2], rest: &Resting) -> bool {
     let (mut sum, mut count) = (0.0, 0usize);
     for (&p, &w) in s.packed.iter().zip(&s.inverse_mass) {
         if w > 0.0 {
@@ -158,7 +157,7 @@ fn lay_out(
     velocity: &[DVec2],
     inverse_mass: &[f64],
     dt: f64,
-    s: &mut JointScratch,
+    s: &mut ContactScratch,
 ) {
     s.parts.clear();
     s.packed.clear();
@@ -242,12 +241,12 @@ fn lay_out(
         buffer.resize(m, 0.0);
     }
     // Free particles only: a pinned particle may end several islands.
-    if s.joint_of.len() < inverse_mass.len() {
-        s.joint_of.resize(inverse_mass.len(), NOT_JOINT);
+    if s.local_of.len() < inverse_mass.len() {
+        s.local_of.resize(inverse_mass.len(), NOT_LOCAL);
     }
     for (j, &p) in s.packed.iter().enumerate() {
         if inverse_mass[p as usize] > 0.0 {
-            s.joint_of[p as usize] = j as u32;
+            s.local_of[p as usize] = j as u32;
         }
     }
 }
@@ -261,7 +260,7 @@ fn lay_out_island<W: Walk>(
     velocity: &[DVec2],
     inverse_mass: &[f64],
     dt: f64,
-    s: &mut JointScratch,
+    s: &mut ContactScratch,
 ) {
     let particles = walk.particles(edges);
     let (first, first_edge) = (s.packed.len() as u32, s.ends.len() as u32);
@@ -300,18 +299,18 @@ fn lay_out_island<W: Walk>(
 fn iterate(
     set: &IslandSet,
     islands: &[u32],
-    settings: &JointSettings,
-    resting: Option<&JointSettings>,
-    s: &mut JointScratch,
-) -> JointOutcome {
+    settings: &ContactSettings,
+    resting: Option<&ContactSettings>,
+    s: &mut ContactScratch,
+) -> ContactOutcome {
     let projection = &settings.projection;
     let tolerance = projection.tolerance.max(ROUND_OFF_FLOOR);
-    let mut outcome = JointOutcome::default();
+    let mut outcome = ContactOutcome::default();
     let mut rows_active = !s.rows.is_empty();
     let mut settings = settings;
     if rows_active
         && settings.solver != ContactSolver::GaussSeidel
-        && super::contact_newton::solve(settings, s, &mut outcome).is_some()
+        && super::newton::solve(settings, s, &mut outcome).is_some()
     {
         // The rows and edges together; then the edges' polish below, rows frozen.
         rows_active = false;
@@ -334,7 +333,7 @@ fn iterate(
         // The polish moves particles by about the residual times an edge: the rows are
         // frozen only once that is no more than they already fall short (the contact
         // tolerance, or where the sweeps stalled above it).
-        let polish = JOINT_POLISH.min(contact_tolerance.max(violation) / shortest);
+        let polish = EDGE_POLISH.min(contact_tolerance.max(violation) / shortest);
         // The rows are met, or met as well as the sweeps manage once that stops
         // improving: freeze them, and polish the edges alone.
         let settled = residual <= polish
@@ -397,7 +396,7 @@ fn iterate(
 
 /// Each part's Newton correction of its edges alone, into `s.base`, its factor kept
 /// for the rows' responses.
-fn edge_step(set: &IslandSet, islands: &[u32], s: &mut JointScratch) {
+fn edge_step(set: &IslandSet, islands: &[u32], s: &mut ContactScratch) {
     s.base.copy_from_slice(&s.correction);
     if s.part_factors.len() < s.parts.len() {
         s.part_factors.resize_with(s.parts.len(), Factors::default);
@@ -432,7 +431,7 @@ fn edge_step(set: &IslandSet, islands: &[u32], s: &mut JointScratch) {
 /// Factor part `p`'s system at the current edges (kept in `s.part_factors[p]`) and
 /// solve its edge correction; false on a singular system (the part then moves only
 /// by its contacts' direct impulses this step).
-fn solve_part<W: Walk>(p: usize, walk: W, s: &mut JointScratch) -> bool {
+fn solve_part<W: Walk>(p: usize, walk: W, s: &mut ContactScratch) -> bool {
     let part = s.parts[p];
     let (first, particles) = (part.particles.0 as usize, part.particles.1 as usize);
     let (first_edge, m) = (part.edges.0 as usize, part.edges.1 as usize);
@@ -471,7 +470,7 @@ fn solve_part<W: Walk>(p: usize, walk: W, s: &mut JointScratch) -> bool {
 mod tests {
     use super::*;
     use crate::constraints::islands::find_islands;
-    use crate::constraints::projection::settings::ProjectionSettings;
+    use crate::constraints::projection::ProjectionSettings;
     use crate::model::{Edge, PointEdgePair};
 
     /// A little world: points, edges joining `pairs`, pinned points.
@@ -509,8 +508,8 @@ mod tests {
             rows: &[ContactRow],
             impulses: &mut [RowImpulse],
             dt: f64,
-            scratch: &mut JointScratch,
-        ) -> JointOutcome {
+            scratch: &mut ContactScratch,
+        ) -> ContactOutcome {
             self.project_by(ContactSolver::Newton, velocity, rows, impulses, dt, scratch)
         }
 
@@ -522,14 +521,14 @@ mod tests {
             rows: &[ContactRow],
             impulses: &mut [RowImpulse],
             dt: f64,
-            scratch: &mut JointScratch,
-        ) -> JointOutcome {
+            scratch: &mut ContactScratch,
+        ) -> ContactOutcome {
             let islands: Vec<u32> = (0..self.set.islands.len() as u32).collect();
             let in_island: Vec<u32> = self.set.edges.iter().flat_map(|e| [e.a, e.b]).collect();
             let loose: Vec<u32> = (0..self.position.len() as u32)
                 .filter(|&p| self.inverse_mass[p as usize] > 0.0 && !in_island.contains(&p))
                 .collect();
-            project_jointly(
+            project_with_contacts(
                 &self.set,
                 &islands,
                 &loose,
@@ -537,7 +536,7 @@ mod tests {
                 rows,
                 impulses,
                 dt,
-                &JointSettings {
+                &ContactSettings {
                     solver,
                     ..settings()
                 },
@@ -554,7 +553,8 @@ mod tests {
             impulses: &mut [RowImpulse],
             dt: f64,
         ) {
-            let outcome = self.project(velocity, rows, impulses, dt, &mut JointScratch::default());
+            let outcome =
+                self.project(velocity, rows, impulses, dt, &mut ContactScratch::default());
             assert!(outcome.converged, "{outcome:?}");
             assert!(self.max_relative_error(velocity, dt) < 1e-12);
             assert!(shortfall(rows, velocity, dt) <= TOLERANCE);
@@ -579,8 +579,8 @@ mod tests {
 
     const TOLERANCE: f64 = 1e-9;
 
-    fn settings() -> JointSettings {
-        JointSettings {
+    fn settings() -> ContactSettings {
+        ContactSettings {
             resting: None,
             projection: ProjectionSettings {
                 tolerance: 1e-13,
@@ -671,7 +671,7 @@ mod tests {
             row(&world, pair(4, 8, 9, 0.5), DVec2::Y, 0.0, dt),
         ];
         let mut impulses = [RowImpulse::default(); 2];
-        let mut scratch = JointScratch::default();
+        let mut scratch = ContactScratch::default();
         let outcome = world.project_by(
             ContactSolver::GaussSeidel,
             &mut velocity,
@@ -741,7 +741,7 @@ mod tests {
                 &rows,
                 &mut impulses,
                 dt,
-                &mut JointScratch::default(),
+                &mut ContactScratch::default(),
             );
             assert!((velocity[0].y * dt).abs() <= TOLERANCE);
             assert!((impulses[0].normal - 1.0).abs() < 1e-6, "{:?}", impulses[0]);
@@ -783,7 +783,7 @@ mod tests {
             &rows,
             &mut impulses,
             dt,
-            &mut JointScratch::default(),
+            &mut ContactScratch::default(),
         );
         // Brute force: S = N W Nᵀ (unit mass), q = N v − target.
         let s = |a: usize, b: usize| rows[a].normal.dot(rows[b].normal);
@@ -886,10 +886,10 @@ mod tests {
             .map(|&(p, q, r)| row(&world, pair(p, q, r, 0.5), DVec2::Y, 0.004, dt))
             .collect();
         for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
-            let mut scratch = JointScratch::default();
+            let mut scratch = ContactScratch::default();
             let mut cold = start.clone();
             let mut impulses = vec![RowImpulse::default(); 2];
-            let project = |v: &mut [DVec2], i: &mut [RowImpulse], s: &mut JointScratch| {
+            let project = |v: &mut [DVec2], i: &mut [RowImpulse], s: &mut ContactScratch| {
                 world.project_by(solver, v, &rows, i, dt, s)
             };
             let first = project(&mut cold, &mut impulses, &mut scratch);
@@ -948,7 +948,7 @@ mod tests {
         for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
             let mut results = Vec::new();
             for threads in [1, 2] {
-                let mut scratch = JointScratch::default();
+                let mut scratch = ContactScratch::default();
                 scratch.set_threads(threads);
                 let mut velocity = start.clone();
                 let mut impulses = vec![RowImpulse::default(); rows.len()];
@@ -1038,14 +1038,14 @@ mod tests {
         for solver in [ContactSolver::GaussSeidel, ContactSolver::Newton] {
             let mut velocity = start.clone();
             let mut impulses = vec![RowImpulse::default(); rows.len()];
-            let settings = JointSettings {
+            let settings = ContactSettings {
                 solver,
                 sweeps: 4000,
                 contact_tolerance: 1e-10,
                 ..settings()
             };
             let islands: Vec<u32> = (0..world.set.islands.len() as u32).collect();
-            let outcome = project_jointly(
+            let outcome = project_with_contacts(
                 &world.set,
                 &islands,
                 &[],
@@ -1054,7 +1054,7 @@ mod tests {
                 &mut impulses,
                 dt,
                 &settings,
-                &mut JointScratch::default(),
+                &mut ContactScratch::default(),
             );
             assert!(outcome.converged, "{solver:?}: {outcome:?}");
             assert!(world.max_relative_error(&velocity, dt) < 1e-12);
@@ -1115,7 +1115,7 @@ mod tests {
             &rows,
             &mut impulses,
             dt,
-            &mut JointScratch::default(),
+            &mut ContactScratch::default(),
         );
         assert!(outcome.contact_violation > 1e-3, "{outcome:?}");
         assert!(outcome.converged, "{outcome:?}");

@@ -12,13 +12,13 @@
 
 use bevy::math::DVec2;
 
-use super::contact_rows::{ContactRow, RowImpulse};
-use super::joint_row::JointRow;
-use super::joint_state::{Bank, JointScratch, LOOSE, NOT_JOINT, Part};
-use super::scratch::Factors;
-use super::view::IslandView;
-use super::walk::{ChainWalk, GraphWalk, Walk};
+use super::local_row::LocalRow;
+use super::rows::{ContactRow, RowImpulse};
+use super::scratch::{Bank, ContactScratch, LOOSE, NOT_LOCAL, Part};
 use crate::constraints::islands::IslandSet;
+use crate::constraints::projection::scratch::Factors;
+use crate::constraints::projection::view::IslandView;
+use crate::constraints::projection::walk::{ChainWalk, GraphWalk, Walk};
 use crate::parallel::{Partner, with_partner};
 
 /// Translate `rows` into joint rows in the cut's sweep order (a row with no free
@@ -28,7 +28,7 @@ pub(super) fn localize_rows(
     impulses: &[RowImpulse],
     velocity: &[DVec2],
     dt: f64,
-    s: &mut JointScratch,
+    s: &mut ContactScratch,
 ) {
     s.rows.clear();
     for bank in &mut s.banks {
@@ -46,7 +46,7 @@ pub(super) fn localize_rows(
         let warm = impulses.get(c).copied().unwrap_or_default();
         let mu_n = (warm.normal * dt).max(0.0);
         let cone = row.friction * mu_n;
-        let mut joint = JointRow {
+        let mut joint = LocalRow {
             normal: row.normal,
             slack_n: (along(row.normal) - row.target) * dt,
             slack_t: along(tangent) * dt,
@@ -56,8 +56,8 @@ pub(super) fn localize_rows(
             ..Default::default()
         };
         for (&p, &coefficient) in row.particles.iter().zip(&row.coefficients) {
-            let j = s.joint_of.get(p as usize).copied().unwrap_or(NOT_JOINT);
-            if j == NOT_JOINT || coefficient == 0.0 {
+            let j = s.local_of.get(p as usize).copied().unwrap_or(NOT_LOCAL);
+            if j == NOT_LOCAL || coefficient == 0.0 {
                 continue;
             }
             joint.entries[joint.count as usize] = (j, coefficient);
@@ -78,7 +78,7 @@ pub(super) fn localize_rows(
         s.rows.push(joint);
     }
     for &p in &s.packed {
-        s.joint_of[p as usize] = NOT_JOINT;
+        s.local_of[p as usize] = NOT_LOCAL;
     }
 }
 
@@ -90,7 +90,7 @@ const UNPLACED: u32 = u32::MAX;
 /// fur three rows in four never do, and room for every row was most of the
 /// projection's memory (and, on a first step, its page faults). Each response is
 /// written in full before it is read.
-fn place(bank: &mut Bank, parts: &[Part], row: &mut JointRow, link: usize) {
+fn place(bank: &mut Bank, parts: &[Part], row: &mut LocalRow, link: usize) {
     let (part, particle_offset, _) = row.links[link];
     if particle_offset != UNPLACED {
         return;
@@ -137,7 +137,7 @@ struct Frame<'a> {
 /// first takes an impulse: later Newton steps keep it (a response one linearization
 /// old is still a fine direction for the sweeps; the edges' own Newton steps keep
 /// them exact).
-fn row_responses(f: &Frame, bank: &mut Bank, row: &mut JointRow) {
+fn row_responses(f: &Frame, bank: &mut Bank, row: &mut LocalRow) {
     for link in 0..row.link_count as usize {
         place(bank, f.parts, row, link);
         let part = f.parts[row.links[link].0 as usize];
@@ -179,7 +179,7 @@ fn row_responses(f: &Frame, bank: &mut Bank, row: &mut JointRow) {
 fn link_responses<W: Walk>(
     f: &Frame,
     bank: &mut Bank,
-    row: &JointRow,
+    row: &LocalRow,
     link: usize,
     walk: Option<W>,
 ) {
@@ -369,9 +369,9 @@ impl<'a, F: FnMut(Job<'a>) -> (&'a mut [DVec2], f64)> SideOne<'a> for Inline<'a,
 /// problem that is not cut has only rows between).
 struct CutSweeps<'f, 'a> {
     frame: &'f Frame<'f>,
-    rows_0: &'a mut [JointRow],
+    rows_0: &'a mut [LocalRow],
     bank_0: &'a mut Bank,
-    between: &'a mut [JointRow],
+    between: &'a mut [LocalRow],
     bank_between: &'a mut Bank,
     split: usize,
     first: bool,
@@ -430,7 +430,7 @@ impl<'a> CutSweeps<'_, 'a> {
 impl Sweeps {
     /// How far (a distance per step) the most violated normal row falls short at the
     /// current corrections.
-    pub(super) fn violation(s: &JointScratch) -> f64 {
+    pub(super) fn violation(s: &ContactScratch) -> f64 {
         let correction = s.correction.as_slice();
         s.rows
             .iter()
@@ -447,7 +447,7 @@ impl Sweeps {
     pub(super) fn run(
         set: &IslandSet,
         islands: &[u32],
-        s: &mut JointScratch,
+        s: &mut ContactScratch,
         first: bool,
         cap: u32,
         tolerance: f64,
@@ -526,7 +526,7 @@ impl Sweeps {
 fn warm(
     f: &Frame,
     bank: &mut Bank,
-    rows: &mut [JointRow],
+    rows: &mut [LocalRow],
     c: &mut impl CorrectionsMut,
     first: bool,
 ) {
@@ -548,7 +548,7 @@ fn warm(
 
 /// One projected Gauss–Seidel sweep over `rows`; returns how far the most violated
 /// normal row fell short before its update.
-fn sweep(f: &Frame, bank: &mut Bank, rows: &mut [JointRow], c: &mut impl CorrectionsMut) -> f64 {
+fn sweep(f: &Frame, bank: &mut Bank, rows: &mut [LocalRow], c: &mut impl CorrectionsMut) -> f64 {
     let mut worst = 0.0f64;
     for row in rows {
         if row.count == 0 {
@@ -584,7 +584,7 @@ fn sweep(f: &Frame, bank: &mut Bank, rows: &mut [JointRow], c: &mut impl Correct
 
 /// `Σ cᵢ d·Δᵢ` of `row` along `d` for the corrections `c`.
 #[inline]
-fn moved<C: Corrections + ?Sized>(c: &C, row: &JointRow, d: DVec2) -> f64 {
+fn moved<C: Corrections + ?Sized>(c: &C, row: &LocalRow, d: DVec2) -> f64 {
     row.entries[..row.count as usize]
         .iter()
         .map(|&(j, coefficient)| coefficient * d.dot(c.at(j as usize)))
@@ -596,7 +596,7 @@ fn moved<C: Corrections + ?Sized>(c: &C, row: &JointRow, d: DVec2) -> f64 {
 fn particle_response<'b>(
     f: &Frame,
     bank: &'b Bank,
-    row: &JointRow,
+    row: &LocalRow,
     link: usize,
     along: Along,
 ) -> (usize, &'b [DVec2]) {
@@ -614,7 +614,7 @@ fn particle_response<'b>(
 
 /// `Σ cᵢ d·rᵢ` over `row`'s particles for its responses `r` along `along`: its own
 /// stiffness with `d` the same direction, the cross term with the other.
-fn stiffness(f: &Frame, bank: &Bank, row: &JointRow, along: Along, d: DVec2) -> f64 {
+fn stiffness(f: &Frame, bank: &Bank, row: &LocalRow, along: Along, d: DVec2) -> f64 {
     let mut value = 0.0;
     for link in 0..row.link_count as usize {
         let (first, r) = particle_response(f, bank, row, link, along);
@@ -631,7 +631,7 @@ fn stiffness(f: &Frame, bank: &Bank, row: &JointRow, along: Along, d: DVec2) -> 
 fn apply(
     f: &Frame,
     bank: &Bank,
-    row: &JointRow,
+    row: &LocalRow,
     c: &mut impl CorrectionsMut,
     normal: f64,
     tangent: f64,
@@ -658,7 +658,7 @@ fn apply(
 
 /// The edge multipliers of this Newton step's contact impulses, `Σ dμ y`, per joint
 /// edge (for the edges' tensions), the rows in sweep order.
-fn multipliers(s: &mut JointScratch) {
+fn multipliers(s: &mut ContactScratch) {
     s.contact_multiplier.fill(0.0);
     let (end_0, end_1) = s.cut.row_ends;
     for (c, row) in s.rows.iter().enumerate() {

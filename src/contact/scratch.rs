@@ -3,10 +3,10 @@
 
 use bevy::math::DVec2;
 
-use super::contact_scratch::NewtonScratch;
-use super::joint_row::JointRow;
-use super::joint_split::JointCut;
-use super::scratch::{Factors, IslandScratch};
+use super::local_row::LocalRow;
+use super::newton::scratch::NewtonScratch;
+use super::split::RowCut;
+use crate::constraints::projection::scratch::{Factors, IslandScratch};
 
 /// One part of the joint problem: an island, or a loose free particle (no edges).
 #[derive(Clone, Copy, Debug, Default)]
@@ -31,11 +31,11 @@ pub(super) struct Part {
 pub(super) const LOOSE: u32 = u32::MAX;
 
 /// Not a particle of the joint problem.
-pub(super) const NOT_JOINT: u32 = u32::MAX;
+pub(super) const NOT_LOCAL: u32 = u32::MAX;
 
-/// Buffers of [`project_jointly`](super::project_jointly), reused from call to call.
+/// Buffers of [`project_with_contacts`](super::project_with_contacts), reused from call to call.
 #[derive(Clone, Debug, Default)]
-pub struct JointScratch {
+pub struct ContactScratch {
     pub(super) parts: Vec<Part>,
     /// Packed index of each joint particle.
     pub(super) packed: Vec<u32>,
@@ -63,13 +63,13 @@ pub struct JointScratch {
     /// Each joint edge's impulse over the projection (mass × length, tension positive).
     pub(super) edge_impulse: Vec<f64>,
     /// The packed → joint particle map (free particles of the parts only).
-    pub(super) joint_of: Vec<u32>,
+    pub(super) local_of: Vec<u32>,
     /// The rows in sweep order (`cut.rows` gives each one's index in the caller's).
-    pub(super) rows: Vec<JointRow>,
+    pub(super) rows: Vec<LocalRow>,
     /// The response room of side 0's rows, side 1's and those between.
     pub(super) banks: [Bank; 3],
     /// The members' layout order and the rows' sweep order.
-    pub(super) cut: JointCut,
+    pub(super) cut: RowCut,
     /// Each member's part.
     pub(super) part_of_member: Vec<u32>,
     /// The first joint particle of side 1 (the particle count when the problem is not
@@ -97,14 +97,14 @@ pub(super) struct Bank {
     pub(super) particle_responses: Vec<DVec2>,
 }
 
-impl JointScratch {
+impl ContactScratch {
     /// Let the sweeps of a cut projection run its two sides at once when `threads` is
     /// more than one (the result is the same whatever the count).
     pub fn set_threads(&mut self, threads: usize) {
         self.threads = threads;
     }
 
-    /// After [`project_jointly`](super::project_jointly): whether the island passed as `islands[i]` met its
+    /// After [`project_with_contacts`](super::project_with_contacts): whether the island passed as `islands[i]` met its
     /// edges (and had its corrections applied).
     pub fn island_met(&self, i: usize) -> bool {
         let part = self.part_of_member.get(i).copied();
@@ -112,7 +112,7 @@ impl JointScratch {
             .unwrap_or(false)
     }
 
-    /// After [`project_jointly`](super::project_jointly): the impulse each edge of the island passed as
+    /// After [`project_with_contacts`](super::project_with_contacts): the impulse each edge of the island passed as
     /// `islands[i]` carried (mass × length, tension positive), in the island's edge
     /// order.
     pub fn edge_impulses(&self, i: usize) -> &[f64] {
@@ -123,7 +123,7 @@ impl JointScratch {
 
 /// The edges at the current corrections, their constraint values and each part's
 /// residual; returns the largest.
-pub(super) fn measure_edges(s: &mut JointScratch) -> f64 {
+pub(super) fn measure_edges(s: &mut ContactScratch) -> f64 {
     let mut largest = 0.0f64;
     for part in &mut s.parts {
         let (first, count) = (part.edges.0 as usize, part.edges.1 as usize);

@@ -1,12 +1,12 @@
 //! The exact line search of the contact Newton: the minimizer, along one step, of its
 //! convex piecewise quadratic objective.
 
-use super::contact_cone::edges;
-use super::joint_row::JointRow;
+use super::cone::edges;
+use crate::contact::local_row::LocalRow;
 
 /// The line of one Newton step: the objective's derivative and slope along it.
 pub(super) struct Line<'a> {
-    pub(super) rows: &'a [JointRow],
+    pub(super) rows: &'a [LocalRow],
     pub(super) stiffness: &'a [f64],
     pub(super) value: &'a [[f64; 2]],
     pub(super) slope: &'a [[f64; 2]],
@@ -96,8 +96,8 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(3);
         for trial in 0..200 {
             let count = rng.random_range(1..12);
-            let rows: Vec<JointRow> = (0..count)
-                .map(|_| JointRow {
+            let rows: Vec<LocalRow> = (0..count)
+                .map(|_| LocalRow {
                     friction: if rng.random_bool(0.5) { 0.3 } else { 0.0 },
                     ..Default::default()
                 })

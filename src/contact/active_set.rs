@@ -14,9 +14,11 @@
 
 use bevy::math::DVec2;
 
-use super::joint_driver::JointDriver;
+use super::driver::GroupDriver;
+use super::rows::{ContactRow, RowImpulse};
+use super::settings::{ContactOutcome, ContactSettings};
 use crate::constraints::islands::IslandSet;
-use crate::constraints::projection::{Bodies, ContactRow, JointOutcome, JointSettings, RowImpulse};
+use crate::constraints::projection::Bodies;
 use crate::metrics::IterationStats;
 use crate::model::NO_ISLAND;
 use crate::model::union_find::UnionFind;
@@ -162,7 +164,7 @@ impl ActiveRows {
         self.take_in_neighbours(set.islands.len(), island, bodies.inverse_mass, rows);
     }
 
-    /// [`JointDriver::project`] over the rows that act: `rows` and `impulses` as there
+    /// [`GroupDriver::project`] over the rows that act: `rows` and `impulses` as there
     /// (a row left out ends with no impulse); the islands projected are those the
     /// acting rows touch. A row acts from the start when it is warm-started or clear of
     /// its target by less than `margin` (a distance over the step); with no margin,
@@ -170,20 +172,20 @@ impl ActiveRows {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn project(
         &mut self,
-        driver: &mut JointDriver,
+        driver: &mut GroupDriver,
         set: &IslandSet,
         island: &[u32],
         bodies: &mut Bodies,
         rows: &[ContactRow],
         impulses: &mut [RowImpulse],
         dt: f64,
-        settings: &JointSettings,
+        settings: &ContactSettings,
         threads: usize,
         stats: &mut IterationStats,
         outcomes: &mut Vec<(u32, bool)>,
         edge_impulse: &mut [f64],
         margin: Option<f64>,
-    ) -> JointOutcome {
+    ) -> ContactOutcome {
         let every_row = match margin {
             None => true,
             Some(margin) => {
@@ -345,8 +347,8 @@ mod tests {
             }
         }
 
-        fn settings() -> JointSettings {
-            JointSettings {
+        fn settings() -> ContactSettings {
+            ContactSettings {
                 resting: None,
                 projection: ProjectionSettings {
                     tolerance: 1e-13,
@@ -367,7 +369,7 @@ mod tests {
             let mut impulses = vec![RowImpulse::default(); self.rows.len()];
             let mut outcomes = Vec::new();
             let mut edge_impulse = vec![0.0; self.set.edges.len()];
-            let mut driver = JointDriver::default();
+            let mut driver = GroupDriver::default();
             driver.reserve(self.set.islands.len(), self.position.len());
             let mut bodies = Bodies::new(&self.position, &mut self.velocity, &self.inverse_mass);
             let mut stats = IterationStats::default();

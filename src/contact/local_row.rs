@@ -7,7 +7,7 @@ use bevy::math::DVec2;
 /// `slack_n + Σ cᵢ n·Δᵢ ≥ 0`; its tangent part asks for no sliding, `slack_t +
 /// Σ cᵢ t·Δᵢ = 0`, with an impulse no larger than `friction` times the normal one.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct JointRow {
+pub(super) struct LocalRow {
     /// `(joint particle, coefficient)` of each free particle.
     pub(super) entries: [(u32, f64); 3],
     pub(super) count: u8,

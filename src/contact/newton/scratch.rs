@@ -2,11 +2,11 @@
 
 use bevy::math::DVec2;
 
-use super::contact_kkt::{Kkt, RowModel};
+use super::kkt::{Kkt, RowModel};
 
 /// The buffers of the contact Newton, reused.
 #[derive(Clone, Debug, Default)]
-pub(super) struct NewtonScratch {
+pub(in crate::contact) struct NewtonScratch {
     pub(super) kkt: Kkt,
     pub(super) model: Vec<RowModel>,
     /// Which rows the system's pattern holds.

@@ -12,9 +12,9 @@ pub type RowSlots = [u32; 3];
 /// No member.
 pub const NONE: u32 = u32::MAX;
 
-/// The groups of the last [`JointGroups::partition`].
+/// The groups of the last [`ContactGroups::partition`].
 #[derive(Clone, Debug, Default)]
-pub struct JointGroups {
+pub struct ContactGroups {
     sets: UnionFind,
     /// Each slot's group.
     pub slot_group: Vec<u32>,
@@ -31,7 +31,7 @@ pub struct JointGroups {
     cursor: Vec<u32>,
 }
 
-impl JointGroups {
+impl ContactGroups {
     /// Group `slots` members joined by `rows`.
     pub fn partition(&mut self, slots: usize, rows: &[RowSlots]) {
         self.sets.reset(slots);
@@ -159,7 +159,7 @@ mod tests {
             [5, NONE, 8],
             [0, NONE, NONE],
         ];
-        let mut groups = JointGroups::default();
+        let mut groups = ContactGroups::default();
         groups.partition(9, &rows);
         // {0}, {1, 7}, {2}, {3, 5, 8}, {4}, {6}
         assert_eq!(groups.count, 6);
@@ -193,7 +193,7 @@ mod tests {
                 row
             })
             .collect();
-        let mut groups = JointGroups::default();
+        let mut groups = ContactGroups::default();
         groups.partition(60, &rows);
         let labels = brute_force(60, &rows);
         for a in 0..60 {
@@ -207,7 +207,7 @@ mod tests {
         }
         let mut reversed = rows.clone();
         reversed.reverse();
-        let mut again = JointGroups::default();
+        let mut again = ContactGroups::default();
         again.partition(60, &reversed);
         assert_eq!(again.slot_group, groups.slot_group);
     }
