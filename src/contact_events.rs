@@ -10,7 +10,7 @@ use bevy::prelude::*;
 use crate::colliders::ColliderOf;
 use crate::collision::CollisionScratch;
 use crate::collision::plugin::check_crossings;
-use crate::rollback::RollbackApp;
+use crate::halving::HalvingApp;
 use crate::schedule::{StepSet, StrandsStep, StrandsTick, TickSet, stepping};
 use crate::world::state::{ParticleState, copy_buffer};
 use crate::world::strand::StrandOf;
@@ -42,7 +42,7 @@ pub struct ContactEventsPlugin;
 impl Plugin for ContactEventsPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<TouchingPairs>()
-            .roll_back::<TouchingPairs, Vec<(Entity, Entity)>>(
+            .save_for_halving::<TouchingPairs, Vec<(Entity, Entity)>>(
                 |pairs, current| {
                     // The two lists trade places every tick: room for the longer.
                     let room = pairs.current.capacity().max(pairs.previous.capacity());

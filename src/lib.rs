@@ -26,10 +26,11 @@
 //! # let _ = rope;
 //! ```
 //!
-//! The layers, bottom up: [`model`] (plain data and rules), the kernels in [`forces`],
-//! [`constraints`] and [`collision`] (slices in, slices out), the ECS layer in [`world`],
-//! and the systems and plugins on top ([`schedule`], each area's `plugin`,
-//! [`contact_loop`], [`metrics`]). The repository's `docs/ARCHITECTURE.md` walks through
+//! The layers, bottom up: [`model`] (plain data and rules) and [`linalg`] (solvers with
+//! no physics), the kernels in [`forces`], [`constraints`] (the edges), [`collision`]
+//! and [`contact`] (the contact solve) (slices in, slices out), the ECS layer in
+//! [`world`], and the systems and plugins on top ([`schedule`], each area's `plugin`,
+//! [`metrics`]). The repository's `docs/ARCHITECTURE.md` walks through
 //! them.
 
 #![warn(missing_docs)]
@@ -46,6 +47,7 @@ pub mod contact;
 pub mod contact_events;
 pub mod forces;
 pub mod guard;
+pub mod halving;
 pub mod integrate;
 pub mod linalg;
 pub mod metrics;
@@ -56,7 +58,6 @@ pub mod rapier;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod ribbon;
-pub mod rollback;
 pub mod schedule;
 pub mod sleeping;
 pub mod snapshot;
@@ -204,7 +205,7 @@ impl PluginGroup for StrandsPlugin {
                 driver: self.driver,
                 length_unit: self.length_unit,
             })
-            .add(rollback::RollbackPlugin)
+            .add(halving::HalvingPlugin)
             .add(ForcesPlugin)
             .add(IntegratorPlugin)
             .add(MetricsPlugin)

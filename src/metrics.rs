@@ -50,7 +50,7 @@ pub struct IterationStats {
     pub capped: u64,
     /// Solves whose corrections were too large to apply and were dropped.
     pub rejected: u64,
-    /// Joint projections whose rows the contact Newton solved (the rest were swept).
+    /// Contact projections whose rows the contact Newton solved (the rest were swept).
     /// (Snapshots from before it read 0.)
     #[cfg_attr(feature = "serde", serde(default))]
     pub newton_solves: u64,
@@ -102,7 +102,7 @@ impl IterationStats {
         self.substeps += other.substeps;
     }
 
-    /// Record a joint projection's factorizations (none: its rows were swept).
+    /// Record a contact projection's factorizations (none: its rows were swept).
     pub fn record_factorizations(&mut self, factorizations: u32) {
         self.newton_solves += u64::from(factorizations > 0);
         self.factorizations += u64::from(factorizations);

@@ -3,7 +3,7 @@
 //! A fixed tick ([`StrandsTick`]) runs the phases of [`TickSet`]: scene logic, sleeping
 //! and waking, the topology rebuild, gathering entity state into the packed arrays, `substeps` runs of
 //! the step schedule, and the write-back. A step that would end in the collision
-//! fail-safe is put back (`rollback`) and taken as two steps of half its size,
+//! fail-safe is put back (`halving`) and taken as two steps of half its size,
 //! down to `dt / 2^max_step_halvings` ([`StrandsConfig::max_step_halvings`]). A step
 //! ([`StrandsStep`]) runs the stages of [`StepSet`] in order:
 //!
@@ -14,7 +14,7 @@
 //!       edge ends the step at its rest length.
 //!    2. **Speculate** — the contact solve: every point that motion would bring
 //!       within reach of an edge becomes a contact row (keep a thickness apart, with
-//!       friction), and every island the rows touch is projected again jointly with
+//!       friction), and every island the rows touch is projected again together with
 //!       them, both sides of each contact moving, every edge exact.
 //! 4. **Collide** — the sub-stages of [`CollideSet`], in order:
 //!    1. **Proximity** — the contact solve's contacts become the step's; without a
@@ -98,7 +98,7 @@ pub enum ConstrainSet {
     Project,
     /// The contact solve: speculative contact rows for the points the projected
     /// motion brings close to an edge, and the islands they touch projected again
-    /// jointly with them.
+    /// together with them.
     Speculate,
 }
 

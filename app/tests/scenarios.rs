@@ -122,7 +122,7 @@ fn the_dense_pile_lands_at_its_default_step_uncrossed_and_exact() {
 fn the_coiling_rope_is_solved_by_the_contact_newton_uncrossed_and_exact() {
     // A 1 000-particle rope dropped in rows: by 0.7 s its lower rows have landed on the
     // floor and the next ones on them. Its rows touch one strand as long as the rope,
-    // so the joint projections go to the contact Newton, not to the sweeps.
+    // so the contact projections go to the contact Newton, not to the sweeps.
     let report = run_ok(&options("rope_coil", 0.7));
     assert_eq!(
         report.edge_crossings,

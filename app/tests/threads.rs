@@ -86,7 +86,7 @@ fn a_rerun_gives_the_same_report_bit_for_bit() {
 }
 
 #[test]
-fn the_joint_groups_shared_between_threads_give_the_same_report() {
+fn the_contact_groups_shared_between_threads_give_the_same_report() {
     // The dense pile: thousands of contact rows a step in many independent groups,
     // projected on two lanes with two threads.
     let one = same_on_one_and_two_threads(|threads| RunOptions {
@@ -96,10 +96,10 @@ fn the_joint_groups_shared_between_threads_give_the_same_report() {
         check_crossings: true,
         ..Default::default()
     });
-    // More joint projections than steps: the steps' rows fell into several groups.
+    // More contact projections than steps: the steps' rows fell into several groups.
     assert!(
         one.contact_projection_solves > 2 * one.steps,
-        "{} joint projections in {} steps",
+        "{} contact projections in {} steps",
         one.contact_projection_solves,
         one.steps
     );

@@ -12,6 +12,8 @@
 //! only. A tick of the strands runs after avian's step in the same schedule: a body
 //! the strands hand over gets its pose and velocity written back for avian's next
 //! step; the others' impulses reach them as forces over that step.
+//!
+//! Imports: [`crate::bodies`], [`crate::world`], [`crate::schedule`], and avian2d.
 
 use bevy::math::Rot2;
 use bevy::prelude::*;

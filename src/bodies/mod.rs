@@ -16,6 +16,9 @@
 //! [`BodyView`] in [`BodySync::Read`], hands each new marked collider's outline to
 //! `outline_collider`, and applies each [`BodyPush`] with its own force API in
 //! [`BodySync::Write`]. This module imports no engine.
+//!
+//! Imports: [`crate::model`], [`crate::world`], [`crate::schedule`], [`crate::halving`],
+//! [`crate::colliders`], [`crate::contact_events`].
 
 pub mod anchor;
 mod carry;
@@ -35,7 +38,7 @@ use bevy::prelude::*;
 use crate::colliders::{
     ColliderShape, OutlineBuild, StrandCollider, spawn_anchored_outline, spawn_outline,
 };
-use crate::rollback::{RollbackApp, StepRollback};
+use crate::halving::{HalvingApp, HalvingSaves};
 use crate::schedule::{CollideSet, ConstrainSet, StepSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::particle::Kinematic;
 pub use anchor::BodyAnchor;
@@ -78,9 +81,9 @@ impl Plugin for BodyCouplingPlugin {
         // bodies between ticks, so an anchored end starts the tick off its length by
         // what the engine moved it, and half the step corrects that twice as fast (a
         // rope of a two-thousandth of its crate flew apart).
-        app.init_resource::<StepRollback>();
+        app.init_resource::<HalvingSaves>();
         app.world_mut()
-            .resource_mut::<StepRollback>()
+            .resource_mut::<HalvingSaves>()
             .forbid_when(|world| {
                 world
                     .get_resource::<BodyCoupling>()
@@ -125,7 +128,7 @@ impl Plugin for BodyCouplingPlugin {
                 ),
             )
             // A step taken again in halves must not count its impulses twice.
-            .roll_back::<BodyCoupling, BodyCoupling>(
+            .save_for_halving::<BodyCoupling, BodyCoupling>(
                 |coupling, saved| saved.copy_from(coupling),
                 |coupling, saved| coupling.copy_from(saved),
             )

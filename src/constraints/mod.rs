@@ -5,8 +5,12 @@
 //! are found once per topology change ([`islands`]); the kind of an island picks its
 //! solver ([`solver`]). The kernels are pure functions on slices: the linear solves
 //! (in [`crate::linalg`], on a [`graph`] layout for trees and graphs), the projection with
-//! the joint projection of islands in contact ([`projection`]) and the relaxation baselines
+//! the contact projection of islands in contact ([`projection`]) and the relaxation baselines
 //! ([`relaxation`]); [`plugin`] holds the thin systems.
+//!
+//! Edge inextensibility only: nothing here knows about contacts ([`crate::contact`]
+//! builds on it). Imports: [`crate::model`], [`crate::linalg`], [`crate::metrics`]; its
+//! plugin, [`crate::world`] and [`crate::schedule`].
 
 pub mod graph;
 pub mod island_edge;

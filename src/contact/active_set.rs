@@ -7,7 +7,7 @@
 //!
 //! Every pair within reach is a row, but most never push: the fur's neighbouring
 //! hairs lie within reach of each other near their roots every step, well clear of
-//! their cushion. Handed to the joint projection, such rows joined every island they
+//! their cushion. Handed to the contact projection, such rows joined every island they
 //! touch into one group, set up and swept every Newton step, for nothing. Left out, a
 //! row clear of its target at the start is checked after the projection instead (in
 //! the limp fur's first second, traced, none was then short: one round every step).

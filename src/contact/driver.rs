@@ -1,4 +1,4 @@
-//! Driving the joint projection of islands in contact: which islands and loose
+//! Driving the contact projection of islands in contact: which islands and loose
 //! particles the rows touch, their independent groups ([`ContactGroups`]), and each group
 //! projected on its own — on several threads when there are enough rows. A group
 //! reads and writes only its own particles (the rows' other particles are pinned or
@@ -19,10 +19,10 @@ use crate::constraints::projection::{Bodies, ProjectionOutcome};
 use crate::metrics::IterationStats;
 use crate::model::NO_ISLAND;
 
-/// Below this many rows a joint projection stays on one thread.
+/// Below this many rows a contact projection stays on one thread.
 const PARALLEL_ROWS: usize = 512;
 
-/// The buffers of joint projections, reused every step.
+/// The buffers of contact projections, reused every step.
 #[derive(Default, Debug)]
 pub(super) struct GroupDriver {
     /// Islands, then loose particles, that the current rows touch (sorted).
@@ -77,7 +77,7 @@ impl GroupDriver {
         self.marks.resize(islands + particles, false);
     }
 
-    /// Project jointly every island `rows` touch (`island` gives each particle's
+    /// Project every island `rows` touch (`island` gives each particle's
     /// island) and the loose free particles they touch: each member's outcome into
     /// `outcomes`, its edges' impulses added to `edge_impulse`.
     #[allow(clippy::too_many_arguments)]

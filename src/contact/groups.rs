@@ -1,4 +1,4 @@
-//! Independent groups of a joint projection: the members (islands and loose particles)
+//! Independent groups of a contact projection: the members (islands and loose particles)
 //! that contact rows join, directly or through other members. Groups share no particle
 //! and no row, so each is projected on its own — to its own number of Newton steps and
 //! sweeps, where one projection of everything would iterate every group until the

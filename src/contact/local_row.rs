@@ -1,14 +1,14 @@
-//! A contact row as the joint projection holds it: its particles and coefficients, its
+//! A contact row as the contact projection holds it: its particles and coefficients, its
 //! normal and slacks, and its impulses so far.
 
 use bevy::math::DVec2;
 
-/// A contact row in joint terms. Its normal part `Σ cᵢ n·(v + Δᵢ/dt) ≥ target` reads
+/// A contact row in local terms. Its normal part `Σ cᵢ n·(v + Δᵢ/dt) ≥ target` reads
 /// `slack_n + Σ cᵢ n·Δᵢ ≥ 0`; its tangent part asks for no sliding, `slack_t +
 /// Σ cᵢ t·Δᵢ = 0`, with an impulse no larger than `friction` times the normal one.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct LocalRow {
-    /// `(joint particle, coefficient)` of each free particle.
+    /// `(local particle, coefficient)` of each free particle.
     pub(super) entries: [(u32, f64); 3],
     pub(super) count: u8,
     pub(super) normal: DVec2,

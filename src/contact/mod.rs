@@ -16,10 +16,12 @@
 //! - [`plugin`]: the systems — the Speculate sub-stage and the contact loop that
 //!   re-projects after the collision stage's impulses.
 //!
-//! Imports: from [`crate::constraints`] (islands, the edge projection's walks and
-//! buffers), [`crate::linalg`], [`crate::collision`], [`crate::model`] and
-//! [`crate::world`]. Nothing below the systems imports from here but the collision
-//! stage's contact events and the step's halving, which save its warm starts.
+//! Imports: [`crate::constraints`] (islands, the edge projection's walks and factors),
+//! [`crate::linalg`], [`crate::model`], [`crate::parallel`], [`crate::metrics`]; its
+//! systems, [`crate::collision`] (the contact loop's impulses), [`crate::world`],
+//! [`crate::schedule`] and [`crate::halving`] (the warm starts a halved step puts
+//! back). Of the layers below, only [`crate::world`]'s configuration names a type of
+//! it ([`ContactSolver`]).
 
 pub mod active_set;
 pub mod driver;

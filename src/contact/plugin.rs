@@ -2,11 +2,11 @@
 //! meet.
 //!
 //! Before any impulse, the contact solve (the Speculate sub-stage) turns every pair
-//! within reach into a contact row and projects the islands they touch jointly with
+//! within reach into a contact row and projects the islands they touch together with
 //! them (`constraints::projection::project_with_contacts`): the rows keep pairs a cushion
 //! apart, with friction, and every edge stays exact. Continuous detection then
 //! verifies the step; what the rows' linearization missed gets collision impulses.
-//! After impulses, the islands they touched are projected again jointly, with every
+//! After impulses, the islands they touched are projected again together, with every
 //! contact as a row that may not approach, and detection runs again; this alternates
 //! until a round applies no impulse or [`ContactConfig::passes`] are done. Collisions
 //! always come last, so non-penetration is never traded for length: what the last
@@ -25,10 +25,10 @@ use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
 use crate::constraints::Islands;
 use crate::constraints::projection::Bodies;
+use crate::halving::HalvingApp;
 use crate::metrics::{IterationStats, StrandMetrics};
 use crate::model::geometry::closest_on_segment;
 use crate::model::{Edge, PointEdgePair};
-use crate::rollback::RollbackApp;
 use crate::schedule::{CollideSet, ConstrainSet, StrandsStep};
 use crate::world::config::{CollisionConfig, ConstraintConfig, ContactConfig, StrandsConfig};
 use crate::world::state::{ParticleState, copy_buffer};
@@ -43,7 +43,7 @@ impl Plugin for ContactLoopPlugin {
             .init_resource::<ContactRows>()
             .register_type::<ContactConfig>()
             // The warm starts are the one thing a step leaves for the next.
-            .roll_back::<ContactRows, (Vec<(u32, u32, RowImpulse)>, u64)>(
+            .save_for_halving::<ContactRows, (Vec<(u32, u32, RowImpulse)>, u64)>(
                 |rows, (warm, version)| {
                     // The warm starts grow with the keys' buffer: so does their copy.
                     let room = rows.keys.capacity().max(rows.warm.capacity());
@@ -68,7 +68,7 @@ impl Plugin for ContactLoopPlugin {
     }
 }
 
-/// The joint projection's settings: the constraint settings, with the contact loop's
+/// The contact projection's settings: the constraint settings, with the contact loop's
 /// correction guard, tolerance and sweeps. Rows give way after `give_way` of the Newton
 /// budget: the speculative solve holds its rows longer (9/10: it is the one that keeps
 /// strands apart), the contact loop's reprojection sooner (1/2: its rows come after a
@@ -101,7 +101,7 @@ fn contact_settings(
 /// again, a second round in one solve in eight (none in 300 steps at half).
 const ACTING_MARGIN: f64 = 0.5;
 
-/// The contact rows of the latest joint projection and the impulses they carried,
+/// The contact rows of the latest contact projection and the impulses they carried,
 /// reused every step.
 #[derive(Resource, Default, Debug)]
 pub struct ContactRows {
@@ -194,9 +194,9 @@ impl ContactRows {
 
 /// The Speculate sub-stage: the contact solve. The pairs the broad phase finds for the
 /// projected motion become rows ([`speculative_rows`]: keep the cushion, no sliding
-/// beyond Coulomb's cone), and every island the rows touch is projected again jointly
+/// beyond Coulomb's cone), and every island the rows touch is projected again together
 /// with them, both sides of each contact moving and every edge exact, warm-started
-/// from the previous step's impulses of the same contacts. An island whose joint
+/// from the previous step's impulses of the same contacts. An island whose contact
 /// projection fails is projected alone again, so that the stage always leaves every
 /// edge met.
 #[allow(clippy::too_many_arguments)]

@@ -1,4 +1,4 @@
-//! The joint projection: every island that a set of contact rows touches, projected
+//! The contact projection: every island that a set of contact rows touches, projected
 //! together with those rows, both sides of every contact moving.
 //!
 //! The unknowns are the corrections Δ to the predicted end of step of the particles of
@@ -18,10 +18,10 @@
 //! to round-off: once they are nearly met the rows are frozen and the last Newton
 //! steps polish the edges alone, converging quadratically.
 //!
-//! A response is kept twice (`joint_rows`): per particle, which the sweeps add to the
+//! A response is kept twice (`sweeps`): per particle, which the sweeps add to the
 //! corrections when a row's impulse changes, and per edge (`A⁻¹ J W f`), summed once
 //! per Newton step into the edges' contact multipliers. The state both work on is in
-//! `joint_state`.
+//! `scratch`.
 
 use bevy::math::DVec2;
 
@@ -44,7 +44,7 @@ use crate::constraints::projection::{ConstraintDirection, ROUND_OFF_FLOOR};
 /// it (the fur held at 2e-4 for ten Newton steps of 16 sweeps each).
 const EDGE_POLISH: f64 = 1e-3;
 
-/// Project `islands` and the `loose` free particles jointly with `rows`: every edge of
+/// Project `islands` and the `loose` free particles together with `rows`: every edge of
 /// every island ends the step at its rest length, and every row is met to the contact
 /// tolerance (normal rows never pulling, friction within the cone), both sides of each
 /// row moving. `impulses[c]` is row c's warm start on entry and its total impulse on
@@ -146,7 +146,7 @@ fn at_rest(s: &ContactScratch, velocity: &[DVec2], rest: &Resting) -> bool {
     count > 0 && sum < rest.speed * count as f64
 }
 
-/// Number the parts' particles and edges jointly, the members in the cut's order, and
+/// Number the parts' particles and edges in one numbering, the members in the cut's order, and
 /// set up the Newton iteration.
 #[allow(clippy::too_many_arguments)]
 fn lay_out(

@@ -1,11 +1,11 @@
-//! Contact rows: the inequalities `Σ cᵢ n·vᵢ ≥ target` a joint projection must
+//! Contact rows: the inequalities `Σ cᵢ n·vᵢ ≥ target` a contact projection must
 //! respect, with friction along their tangent, and the impulses they carry.
 
 use bevy::math::DVec2;
 
 use crate::model::PointEdgePair;
 
-/// A contact that a joint projection must not make approach: `Σ cᵢ n·vᵢ ≥ target`.
+/// A contact that a contact projection must not make approach: `Σ cᵢ n·vᵢ ≥ target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactRow {
     /// The particles involved (packed indices).
@@ -16,7 +16,7 @@ pub struct ContactRow {
     pub normal: DVec2,
     /// The smallest allowed `Σ cᵢ n·vᵢ`.
     pub target: f64,
-    /// Coulomb friction coefficient of the row's tangential part (a joint projection
+    /// Coulomb friction coefficient of the row's tangential part (a contact projection
     /// stops sliding along `normal.perp()` with at most this times the normal impulse).
     pub friction: f64,
 }

@@ -1,5 +1,5 @@
-//! The joint projection's state: its parts, its rows in joint terms and the buffers
-//! both the Newton iterations (`joint`) and the rows' sweeps (`joint_rows`) work on.
+//! The contact projection's state: its parts, its rows in local terms and the buffers
+//! both the Newton iterations (`projection`) and the rows' sweeps (`sweeps`) work on.
 
 use bevy::math::DVec2;
 
@@ -8,14 +8,14 @@ use super::newton::scratch::NewtonScratch;
 use super::split::RowCut;
 use crate::constraints::projection::scratch::{Factors, IslandScratch};
 
-/// One part of the joint problem: an island, or a loose free particle (no edges).
+/// One part of the contact problem: an island, or a loose free particle (no edges).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Part {
     /// The island's position in the `islands` argument, or [`LOOSE`].
     pub(super) island: u32,
-    /// First joint particle and count.
+    /// First local particle and count.
     pub(super) particles: (u32, u32),
-    /// First joint edge and count.
+    /// First local edge and count.
     pub(super) edges: (u32, u32),
     pub(super) shortest: f64,
     pub(super) residual: f64,
@@ -30,26 +30,26 @@ pub(super) struct Part {
 /// Marks a part that is a loose particle.
 pub(super) const LOOSE: u32 = u32::MAX;
 
-/// Not a particle of the joint problem.
+/// Not a particle of the contact problem.
 pub(super) const NOT_LOCAL: u32 = u32::MAX;
 
 /// Buffers of [`project_with_contacts`](super::project_with_contacts), reused from call to call.
 #[derive(Clone, Debug, Default)]
 pub struct ContactScratch {
     pub(super) parts: Vec<Part>,
-    /// Packed index of each joint particle.
+    /// Packed index of each local particle.
     pub(super) packed: Vec<u32>,
     pub(super) inverse_mass: Vec<f64>,
-    /// The correction Δ of each joint particle.
+    /// The correction Δ of each local particle.
     pub(super) correction: Vec<DVec2>,
     /// Δ at the start of the current Newton step.
     pub(super) step_start: Vec<DVec2>,
     /// Δ after the current Newton step's edge correction, before contacts.
     pub(super) base: Vec<DVec2>,
-    /// Edges at each joint particle: `(joint edge, ±1)`, from `incident_start`.
+    /// Edges at each local particle: `(local edge, ±1)`, from `incident_start`.
     pub(super) incident: Vec<(u32, f64)>,
     pub(super) incident_start: Vec<u32>,
-    /// Joint ends of each joint edge.
+    /// Local ends of each local edge.
     pub(super) ends: Vec<(u32, u32)>,
     pub(super) rest_squared: Vec<f64>,
     pub(super) predicted_edge: Vec<DVec2>,
@@ -58,11 +58,11 @@ pub struct ContactScratch {
     pub(super) locked: Vec<bool>,
     /// Edge multipliers of this Newton step's edge correction.
     pub(super) edge_multiplier: Vec<f64>,
-    /// Contact multipliers `Σ dμ A⁻¹ J W f` of this Newton step, per joint edge.
+    /// Contact multipliers `Σ dμ A⁻¹ J W f` of this Newton step, per local edge.
     pub(super) contact_multiplier: Vec<f64>,
-    /// Each joint edge's impulse over the projection (mass × length, tension positive).
+    /// Each local edge's impulse over the projection (mass × length, tension positive).
     pub(super) edge_impulse: Vec<f64>,
-    /// The packed → joint particle map (free particles of the parts only).
+    /// The packed → local particle map (free particles of the parts only).
     pub(super) local_of: Vec<u32>,
     /// The rows in sweep order (`cut.rows` gives each one's index in the caller's).
     pub(super) rows: Vec<LocalRow>,
@@ -72,7 +72,7 @@ pub struct ContactScratch {
     pub(super) cut: RowCut,
     /// Each member's part.
     pub(super) part_of_member: Vec<u32>,
-    /// The first joint particle of side 1 (the particle count when the problem is not
+    /// The first local particle of side 1 (the particle count when the problem is not
     /// cut: every particle is then on side 0).
     pub(super) side_1: usize,
     /// Threads the sweeps may use (a cut problem's sides take two at most).

@@ -5,11 +5,11 @@ use bevy::prelude::Reflect;
 
 use crate::constraints::projection::ProjectionSettings;
 
-/// How a joint projection finds its contact rows' impulses.
+/// How a contact projection finds its contact rows' impulses.
 #[derive(Reflect, Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ContactSolver {
-    /// Each joint projection by whichever of the two below costs less for it (an
+    /// Each contact projection by whichever of the two below costs less for it (an
     /// estimate from the rows' response lengths and the factor's fill): Newton for
     /// long strands, the sweeps for short ones in a dense pile.
     #[default]
@@ -78,7 +78,7 @@ pub struct Resting {
     pub tolerance: f64,
 }
 
-/// How a joint projection is asked to stop.
+/// How a contact projection is asked to stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactSettings {
     /// The edges' tolerance and the cap on Newton steps (the direction is always the
@@ -102,7 +102,7 @@ pub struct ContactSettings {
     pub solver: ContactSolver,
 }
 
-/// How a joint projection ended.
+/// How a contact projection ended.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactOutcome {
     /// Newton steps.

@@ -1,4 +1,4 @@
-//! Cutting a large joint projection in two so that both cores can sweep its rows.
+//! Cutting a large contact projection in two so that both cores can sweep its rows.
 //!
 //! The members (islands and loose particles) are cut by position into two sides of
 //! about equal row counts; the rows are then those of side 0, those of side 1, and
@@ -13,7 +13,7 @@ use bevy::math::DVec2;
 use super::rows::{ContactRow, RowImpulse};
 use crate::constraints::islands::IslandSet;
 
-/// A joint projection with fewer rows than this is swept as one: the cut costs a pass
+/// A contact projection with fewer rows than this is swept as one: the cut costs a pass
 /// over the rows and a thread hand-off per sweep, which small problems do not repay.
 pub const CUT_ROWS: usize = 2048;
 
@@ -30,7 +30,7 @@ const SIDE_0: u8 = 0;
 const SIDE_1: u8 = 1;
 const BETWEEN: u8 = 2;
 
-/// The cut of one joint projection, and its buffers.
+/// The cut of one contact projection, and its buffers.
 #[derive(Clone, Debug, Default)]
 pub(super) struct RowCut {
     /// The members (islands by position in the projection's list, then loose particles
@@ -51,7 +51,7 @@ pub(super) struct RowCut {
     class: Vec<u8>,
 }
 
-/// The members of a joint projection: the islands `islands` of `set`, then the
+/// The members of a contact projection: the islands `islands` of `set`, then the
 /// `loose` particles.
 #[derive(Clone, Copy)]
 pub(super) struct Members<'a> {

@@ -1,4 +1,4 @@
-//! The contact rows of a joint projection: their joint form, the parts' responses to
+//! The contact rows of a contact projection: their local form, the parts' responses to
 //! them, and the projected Gauss–Seidel sweeps that find their impulses.
 //!
 //! A row's response on a part is kept twice: per particle (`r = W f − W Jᵀ y`, what
@@ -6,7 +6,7 @@
 //! (`y = A⁻¹ J W f`, the multipliers it asks of the part's edges, summed once per
 //! Newton step for the edges' tensions).
 //!
-//! The rows come in three groups (`joint_split`): side 0's, side 1's, and those
+//! The rows come in three groups (`split`): side 0's, side 1's, and those
 //! between. Each sweep visits them in that order; the two sides' rows move disjoint
 //! particles, so on two threads they are swept at once, and the result is the same.
 
@@ -21,7 +21,7 @@ use crate::constraints::projection::view::IslandView;
 use crate::constraints::projection::walk::{ChainWalk, GraphWalk, Walk};
 use crate::parallel::{Partner, with_partner};
 
-/// Translate `rows` into joint rows in the cut's sweep order (a row with no free
+/// Translate `rows` into local rows in the cut's sweep order (a row with no free
 /// particle among the parts stays inert), warm-started from `impulses`.
 pub(super) fn localize_rows(
     rows: &[ContactRow],
@@ -46,7 +46,7 @@ pub(super) fn localize_rows(
         let warm = impulses.get(c).copied().unwrap_or_default();
         let mu_n = (warm.normal * dt).max(0.0);
         let cone = row.friction * mu_n;
-        let mut joint = LocalRow {
+        let mut local = LocalRow {
             normal: row.normal,
             slack_n: (along(row.normal) - row.target) * dt,
             slack_t: along(tangent) * dt,
@@ -60,22 +60,22 @@ pub(super) fn localize_rows(
             if j == NOT_LOCAL || coefficient == 0.0 {
                 continue;
             }
-            joint.entries[joint.count as usize] = (j, coefficient);
-            joint.count += 1;
+            local.entries[local.count as usize] = (j, coefficient);
+            local.count += 1;
             let part = part_of(&s.parts, j) as u32;
-            if !joint.links[..joint.link_count as usize]
+            if !local.links[..local.link_count as usize]
                 .iter()
                 .any(|&(q, ..)| q == part)
             {
-                joint.links[joint.link_count as usize] = (part, UNPLACED, UNPLACED);
-                joint.link_count += 1;
+                local.links[local.link_count as usize] = (part, UNPLACED, UNPLACED);
+                local.link_count += 1;
             }
         }
-        if joint.count == 0 {
-            joint.mu_n = 0.0;
-            joint.mu_t = 0.0;
+        if local.count == 0 {
+            local.mu_n = 0.0;
+            local.mu_t = 0.0;
         }
-        s.rows.push(joint);
+        s.rows.push(local);
     }
     for &p in &s.packed {
         s.local_of[p as usize] = NOT_LOCAL;
@@ -109,7 +109,7 @@ fn place(bank: &mut Bank, parts: &[Part], row: &mut LocalRow, link: usize) {
     }
 }
 
-/// The part holding joint particle `j` (parts are laid out in particle order).
+/// The part holding local particle `j` (parts are laid out in particle order).
 fn part_of(parts: &[Part], j: u32) -> usize {
     parts.partition_point(|p| p.particles.0 + p.particles.1 <= j)
 }
@@ -246,11 +246,11 @@ fn link_responses<W: Walk>(
 
 /// The corrections a group of rows reads.
 trait Corrections {
-    /// Joint particle `j`'s correction.
+    /// Local particle `j`'s correction.
     fn at(&self, j: usize) -> DVec2;
 }
 
-/// Every joint particle's corrections.
+/// Every local particle's corrections.
 impl Corrections for [DVec2] {
     #[inline]
     fn at(&self, j: usize) -> DVec2 {
@@ -260,11 +260,11 @@ impl Corrections for [DVec2] {
 
 /// The corrections a group of rows reads and writes.
 trait CorrectionsMut: Corrections {
-    /// The corrections of the `count` joint particles from `first` (one part's).
+    /// The corrections of the `count` local particles from `first` (one part's).
     fn run_mut(&mut self, first: usize, count: usize) -> &mut [DVec2];
 }
 
-/// The corrections of the joint particles from `first` on.
+/// The corrections of the local particles from `first` on.
 struct Run<'a> {
     first: usize,
     values: &'a mut [DVec2],
@@ -284,7 +284,7 @@ impl CorrectionsMut for Run<'_> {
     }
 }
 
-/// Side 0's corrections and side 1's, which start at joint particle `split`: what the
+/// Side 0's corrections and side 1's, which start at local particle `split`: what the
 /// rows between the sides see.
 struct Sides<'a> {
     low: &'a mut [DVec2],
@@ -364,7 +364,7 @@ impl<'a, F: FnMut(Job<'a>) -> (&'a mut [DVec2], f64)> SideOne<'a> for Inline<'a,
     }
 }
 
-/// A joint projection's contact solve: side 0's rows here, side 1's wherever `SideOne`
+/// A contact projection's contact solve: side 0's rows here, side 1's wherever `SideOne`
 /// runs them, at the same time, then the rows between; the same order on either (a
 /// problem that is not cut has only rows between).
 struct CutSweeps<'f, 'a> {
@@ -592,7 +592,7 @@ fn moved<C: Corrections + ?Sized>(c: &C, row: &LocalRow, d: DVec2) -> f64 {
 }
 
 /// The particle responses of link `link` of `row` along `along`: the part's first
-/// joint particle and the responses.
+/// local particle and the responses.
 fn particle_response<'b>(
     f: &Frame,
     bank: &'b Bank,
@@ -656,7 +656,7 @@ fn apply(
     }
 }
 
-/// The edge multipliers of this Newton step's contact impulses, `Σ dμ y`, per joint
+/// The edge multipliers of this Newton step's contact impulses, `Σ dμ y`, per local
 /// edge (for the edges' tensions), the rows in sweep order.
 fn multipliers(s: &mut ContactScratch) {
     s.contact_multiplier.fill(0.0);

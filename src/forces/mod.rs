@@ -5,6 +5,9 @@
 //!
 //! User forces go in [`StepSet::Forces`](crate::schedule::StepSet::Forces) after
 //! [`plugin::apply_tethers`], adding to the accumulator.
+//!
+//! Imports: [`crate::model`], [`crate::linalg`] (the implicit bending's sparse solve),
+//! [`crate::parallel`]; its plugin, [`crate::world`] and [`crate::schedule`].
 
 pub mod bending;
 pub mod damping;

@@ -18,6 +18,9 @@
 //! 1e-9) freezes its island with a [`Quantity::Stretch`] message, and kinetic energy no
 //! force in the scene explains (the [`energy`] check, at a tick's end) freezes the
 //! island of its fastest particle with a [`Quantity::Speed`] message.
+//!
+//! Imports: [`crate::model`], [`crate::forces`] (the energy the scene's forces can
+//! explain), [`crate::metrics`], [`crate::world`], [`crate::schedule`].
 
 pub mod energy;
 

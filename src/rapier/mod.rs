@@ -15,6 +15,8 @@
 //! to whatever force the game sets, and taken off again a tick later). Bodies
 //! are read from their `Transform`, so a coupled body sits at the root of its
 //! hierarchy, as Rapier's own bodies normally do; a collider may be the body's child.
+//!
+//! Imports: [`crate::bodies`], [`crate::world`], [`crate::schedule`], and bevy_rapier2d.
 
 use bevy::math::Rot2;
 use bevy::prelude::*;

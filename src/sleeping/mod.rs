@@ -21,6 +21,9 @@
 //!
 //! Waking is per unit: a strand something touches wakes alone, and its sleeping
 //! neighbours hold still until something moving reaches them in turn.
+//!
+//! Imports: [`crate::model`], [`crate::collision`] (the broad phase's grid for the reach
+//! test), [`crate::metrics`], [`crate::world`], [`crate::schedule`].
 
 pub mod reach;
 pub mod units;

@@ -481,12 +481,12 @@ pub struct ContactConfig {
     /// pass finds no new collision, so at small steps one or two run whatever the cap.
     /// 0 leaves edges next to contacts as the impulses leave them.
     pub passes: u32,
-    /// Gauss–Seidel sweeps over the contact rows per Newton step of a joint
+    /// Gauss–Seidel sweeps over the contact rows per Newton step of a contact
     /// projection, at most. The impulses are warm-started from the previous step, so
     /// a resting pile needs few; the cap bounds a step's cost when many contacts
     /// change at once.
     pub sweeps: u32,
-    /// A joint projection that would move any particle by more than this many of its
+    /// A contact projection that would move any particle by more than this many of its
     /// island's shortest rest lengths in one step is refused for that island: room for
     /// a strand that lands moving a good part of an edge per step, while a nearly
     /// dependent set of rows asking for absurd corrections is still refused.
@@ -512,12 +512,12 @@ pub struct ContactConfig {
     /// row.
     pub reach: f64,
     /// Run the contact solve before any impulse (speculative contacts): every pair
-    /// within reach becomes a row of a joint projection, so landings, resting contact
+    /// within reach becomes a row of a contact projection, so landings, resting contact
     /// and strands lying on strands are met inside the exact projection, both sides
     /// moving, rather than by impulses. Off, proximity and collision impulses do the
     /// work and the contact loop re-projects what they stretched.
     pub speculative: bool,
-    /// How a joint projection finds its rows' impulses: by default (`Auto`) each
+    /// How a contact projection finds its rows' impulses: by default (`Auto`) each
     /// group by whichever costs it less, Newton's method on the rows and edges
     /// together for long strands or projected Gauss–Seidel over each row's response on
     /// its whole strands for short ones; either can be asked for.

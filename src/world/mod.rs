@@ -5,6 +5,9 @@
 //! rebuild, which packs the simulated particles into the arrays of [`state`] that the
 //! stages run on ([`sync`] copies between the two). [`config`] holds every setting,
 //! [`clock`] the simulated time and [`problems`] what was refused and why.
+//!
+//! Imports: [`crate::model`], and from the kernels only the setting types its
+//! configuration holds (solver kinds, the broad phase's method).
 
 pub mod builder;
 pub mod clock;

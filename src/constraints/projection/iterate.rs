@@ -1,6 +1,6 @@
 //! The Newton iterations of a projection: from the correction in the scratch, solve
 //! the island's system for the edge multipliers and move the correction, until every
-//! edge meets the tolerance or the cap is hit. Shared by one projection (`newton`) and
+//! edge meets the tolerance or the cap is hit. Shared by one projection (`project`) and
 //! each substep of a re-stepped one (`restep`).
 
 use bevy::math::DVec2;

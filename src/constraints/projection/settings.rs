@@ -46,7 +46,7 @@ pub struct ProjectionOutcome {
     pub singular: bool,
     /// Edges of zero length, left as they are (they have no direction to act along).
     pub locked: u32,
-    /// Whether the corrections were too large to be applied (a joint projection's
+    /// Whether the corrections were too large to be applied (a contact projection's
     /// guard) and were not.
     pub rejected: bool,
     /// Whether the island was stepped again in substeps after one projection failed.

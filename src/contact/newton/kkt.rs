@@ -1,4 +1,4 @@
-//! The contact Newton's linear system over a joint projection's particles and edges.
+//! The contact Newton's linear system over a contact projection's particles and edges.
 //!
 //! Unknowns: each free particle's correction (x, y) and each edge's multiplier. The
 //! matrix is `[H Jᵀ; J 0]`: H the masses plus the stiffness of the contact rows the
@@ -21,7 +21,7 @@ use crate::linalg::symbolic::LdlPattern;
 /// Not an unknown (a fixed particle, a locked edge).
 pub(super) const NONE: u32 = u32::MAX;
 
-/// What the system is built from: the joint projection's particles, edges and rows.
+/// What the system is built from: the contact projection's particles, edges and rows.
 #[derive(Clone, Copy)]
 pub(super) struct KktInput<'a> {
     pub(super) inverse_mass: &'a [f64],
@@ -53,15 +53,15 @@ impl RowModel {
 /// The numbering, pattern, values and factor of the system, reused.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Kkt {
-    /// Threads the factorization may use (the joint projection's own).
+    /// Threads the factorization may use (the contact projection's own).
     pub(super) threads: usize,
-    /// Each joint particle's x unknown (y follows), or [`NONE`] when it is fixed.
+    /// Each local particle's x unknown (y follows), or [`NONE`] when it is fixed.
     pub(super) particle_unknown: Vec<u32>,
-    /// Each joint edge's unknown, or [`NONE`] when it is locked.
+    /// Each local edge's unknown, or [`NONE`] when it is locked.
     pub(super) edge_unknown: Vec<u32>,
     negative: Vec<bool>,
     scale: Vec<f64>,
-    /// The free joint particles, and each joint particle's index among them.
+    /// The free local particles, and each local particle's index among them.
     free: Vec<u32>,
     compact: Vec<u32>,
     graph_start: Vec<u32>,

@@ -1,4 +1,4 @@
-//! The contact Newton: a joint projection's rows and edges solved together by Newton's
+//! The contact Newton: a contact projection's rows and edges solved together by Newton's
 //! method on one sparse system, so that a row costs its own three particles whatever
 //! the length of the strands it touches.
 //!
@@ -20,14 +20,14 @@
 //! unique.
 //!
 //! Each Newton step linearizes the edges at the iterate and solves `[H Jᵀ; J 0]`
-//! (`contact_kkt`) twice with one factorization: for the full step, and for the step
+//! (`kkt`) twice with one factorization: for the full step, and for the step
 //! that only meets the edges. The edges' part is taken whole; the rest is taken whole
 //! for a few steps (the rows' states then follow the iterate, as in a primal–dual
 //! active set), then with an exact line search on the objective (MuJoCo's primal
 //! Newton, Todorov 2014, with hard edges). The iterate is kept as impulses, every row's
 //! and edge's equal and opposite on its particles, and Δ = W P: momentum is kept to
-//! round-off at every step. Once the rows are met and the edges nearly so, the joint
-//! projection's last Newton steps polish the edges alone (`joint`).
+//! round-off at every step. Once the rows are met and the edges nearly so, the contact
+//! projection's last Newton steps polish the edges alone (`projection`).
 
 mod cone;
 mod kkt;
@@ -73,7 +73,7 @@ fn cone_values(row: &LocalRow, r: usize, w: &NewtonScratch, delta: &[DVec2]) -> 
     [0, 1].map(|x| e[x].0 * un + e[x].1 * ut - w.shift[r][x])
 }
 
-/// Solve the rows and edges of the laid-out joint projection in `s` together, from
+/// Solve the rows and edges of the laid-out contact projection in `s` together, from
 /// the rows' warm-start impulses: `s.correction`, the rows' impulses and the edges'
 /// impulses hold the result. Returns whether the rows were met, or `None`, touching
 /// nothing, when the sweeps would cost less (see [`prefers_sweeps`]).
@@ -122,7 +122,7 @@ fn mass_spread(inverse_mass: &[f64]) -> f64 {
     if high > 0.0 { high / low } else { 1.0 }
 }
 
-/// A joint group whose free particles' masses spread wider than this is left to the
+/// A contact group whose free particles' masses spread wider than this is left to the
 /// Newton under `Auto`: a crate on a rope two thousand times lighter measured 2 275
 /// fail-safe steps in 3 000 by the sweeps at 1/600 s, 7 by the Newton.
 const SWEPT_MASS_SPREAD: f64 = 100.0;

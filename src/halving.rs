@@ -1,4 +1,4 @@
-//! Taking a step again: what a step changes, saved before it so that a step that would
+//! Step halving, the step's own fallback: what a step changes, saved before it so that a step that would
 //! end in the collision fail-safe can be put back and taken as two halves.
 //!
 //! Each area registers the state its step systems carry from one step to the next (the
@@ -21,21 +21,21 @@ use crate::world::state::ParticleState;
 
 /// Runs a tick's steps, each taken again in halves where it would end in the
 /// fail-safe, and registers what every step carries forward.
-pub struct RollbackPlugin;
+pub struct HalvingPlugin;
 
-impl Plugin for RollbackPlugin {
+impl Plugin for HalvingPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
         // What every step carries forward, for a step taken again in halves.
-        app.roll_back::<ParticleState, ParticleState>(
+        app.save_for_halving::<ParticleState, ParticleState>(
             |state, saved| saved.copy_from(state),
             |state, saved| state.copy_from(saved),
         )
-        .roll_back::<StrandMetrics, StrandMetrics>(
+        .save_for_halving::<StrandMetrics, StrandMetrics>(
             |metrics, saved| saved.copy_from(metrics),
             |metrics, saved| metrics.copy_from(saved),
         )
-        .roll_back_clone::<SimulationClock>();
+        .save_clone_for_halving::<SimulationClock>();
     }
 }
 
@@ -64,9 +64,9 @@ fn run_steps(world: &mut World) {
 /// counts once in [`StrandMetrics::failsafe_steps`] however it was cut.
 fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
     let saving = halvings > 0
-        && (world.get_resource::<StepRollback>()).is_some_and(|rollback| rollback.allows(world));
+        && (world.get_resource::<HalvingSaves>()).is_some_and(|saves| saves.allows(world));
     if saving {
-        world.resource_scope(|world, mut rollback: Mut<StepRollback>| rollback.save(world));
+        world.resource_scope(|world, mut saves: Mut<HalvingSaves>| saves.save(world));
     }
     let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
     schedule.run(world);
@@ -75,7 +75,7 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
         return failed;
     }
     // (A halved step's own save replaces this one: it is no longer needed.)
-    world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
+    world.resource_scope(|world, saves: Mut<HalvingSaves>| saves.restore(world));
     world.resource_mut::<StrandMetrics>().halved_steps += 1;
     let dt = world.resource::<StrandsConfig>().dt;
     world.resource_mut::<StrandsConfig>().dt = 0.5 * dt;
@@ -128,21 +128,21 @@ impl<T: Resource<Mutability = Mutable>, S: Send + Sync + 'static> Entry for Slot
 /// The state a step carries forward, as registered by each area's plugin, and its copy
 /// from before the current step.
 #[derive(Resource, Default)]
-pub struct StepRollback {
+pub struct HalvingSaves {
     entries: Vec<Box<dyn Entry>>,
     vetoes: Vec<fn(&World) -> bool>,
 }
 
-impl std::fmt::Debug for StepRollback {
+impl std::fmt::Debug for HalvingSaves {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("StepRollback")
+        f.debug_struct("HalvingSaves")
             .field("registered", &self.entries.len())
             .field("vetoes", &self.vetoes.len())
             .finish()
     }
 }
 
-impl StepRollback {
+impl HalvingSaves {
     /// Save resource `T` before each step with `save` (into a buffer of type `S` kept
     /// between steps), put back by `restore` when the step is taken again.
     pub fn register<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
@@ -185,7 +185,7 @@ impl StepRollback {
         }
     }
 
-    /// Put every resource saved by the last [`StepRollback::save`] back as it was.
+    /// Put every resource saved by the last [`HalvingSaves::save`] back as it was.
     pub fn restore(&self, world: &mut World) {
         for entry in &self.entries {
             entry.restore(world);
@@ -193,38 +193,39 @@ impl StepRollback {
     }
 }
 
-/// Registering state with [`StepRollback`] from a plugin.
-pub trait RollbackApp {
-    /// See [`StepRollback::register`].
-    fn roll_back<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
+/// Registering state with [`HalvingSaves`] from a plugin.
+pub trait HalvingApp {
+    /// See [`HalvingSaves::register`].
+    fn save_for_halving<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
         &mut self,
         save: fn(&T, &mut S),
         restore: fn(&mut T, &S),
     ) -> &mut Self;
-    /// See [`StepRollback::register_clone`].
-    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone + Default>(&mut self)
-    -> &mut Self;
+    /// See [`HalvingSaves::register_clone`].
+    fn save_clone_for_halving<T: Resource<Mutability = Mutable> + Clone + Default>(
+        &mut self,
+    ) -> &mut Self;
 }
 
-impl RollbackApp for App {
-    fn roll_back<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
+impl HalvingApp for App {
+    fn save_for_halving<T: Resource<Mutability = Mutable>, S: Default + Send + Sync + 'static>(
         &mut self,
         save: fn(&T, &mut S),
         restore: fn(&mut T, &S),
     ) -> &mut Self {
-        self.init_resource::<StepRollback>();
+        self.init_resource::<HalvingSaves>();
         self.world_mut()
-            .resource_mut::<StepRollback>()
+            .resource_mut::<HalvingSaves>()
             .register(save, restore);
         self
     }
 
-    fn roll_back_clone<T: Resource<Mutability = Mutable> + Clone + Default>(
+    fn save_clone_for_halving<T: Resource<Mutability = Mutable> + Clone + Default>(
         &mut self,
     ) -> &mut Self {
-        self.init_resource::<StepRollback>();
+        self.init_resource::<HalvingSaves>();
         self.world_mut()
-            .resource_mut::<StepRollback>()
+            .resource_mut::<HalvingSaves>()
             .register_clone::<T>();
         self
     }

@@ -1,11 +1,11 @@
-//! A step taken again: what [`StepRollback`] saves before a step is put back exactly,
+//! A step taken again: what [`HalvingSaves`] saves before a step is put back exactly,
 //! so a step that would end in the fail-safe and is taken as two halves starts the
 //! halves from where the step started.
 
 use bevy::math::DVec2;
 use bevy::prelude::*;
+use bevy_strands::halving::HalvingSaves;
 use bevy_strands::prelude::*;
-use bevy_strands::rollback::StepRollback;
 use bevy_strands::schedule::StrandsStep;
 
 #[test]
@@ -35,10 +35,10 @@ fn a_step_put_back_leaves_the_state_as_it_was() {
         world.resource::<StrandMetrics>().clone(),
         *world.resource::<SimulationClock>(),
     );
-    world.resource_scope(|world, mut rollback: Mut<StepRollback>| rollback.save(world));
+    world.resource_scope(|world, mut saves: Mut<HalvingSaves>| saves.save(world));
     world.run_schedule(StrandsStep);
     assert_ne!(world.resource::<ParticleState>().position, before.0);
-    world.resource_scope(|world, rollback: Mut<StepRollback>| rollback.restore(world));
+    world.resource_scope(|world, saves: Mut<HalvingSaves>| saves.restore(world));
     let after = (
         world.resource::<ParticleState>().position.clone(),
         world.resource::<ParticleState>().velocity.clone(),
