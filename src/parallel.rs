@@ -39,6 +39,20 @@ pub fn run_each<P: Send, R: Send>(parts: Vec<P>, work: impl Fn(usize, P) -> R + 
     })
 }
 
+/// `each(lane)` for every lane of `rest` on a scoped thread of its own while `first`
+/// runs on this thread; returns when all are done. For stages that keep one lane of
+/// buffers per thread from step to step (the islands' projection, the contact groups'):
+/// nothing is allocated here but the threads.
+pub fn alongside<L: Send>(rest: &mut [L], each: impl Fn(&mut L) + Sync, first: impl FnOnce()) {
+    let each = &each;
+    std::thread::scope(|scope| {
+        for lane in rest.iter_mut() {
+            scope.spawn(move || each(lane));
+        }
+        first();
+    });
+}
+
 /// `work(first index, run)` over `threads` contiguous runs of `items` that start at
 /// multiples of `align`; the results in run order.
 pub fn in_runs<T: Send, R: Send>(

@@ -12,6 +12,7 @@ use super::relaxation::{Relaxation, RelaxationScratch, relax};
 use super::solver::SolverKind;
 use crate::metrics::{IterationStats, StrandMetrics, count_elements};
 use crate::model::NO_ISLAND;
+use crate::parallel::alongside;
 use crate::schedule::{ConstrainSet, StrandsStep, StrandsTick, TickSet};
 use crate::world::config::{ConstraintConfig, StrandsConfig};
 use crate::world::problems::InputProblems;
@@ -121,30 +122,31 @@ impl Islands {
             lane.stats = IterationStats::default();
         }
         let (set, solved) = (&*set, &*solved);
-        std::thread::scope(|scope| {
-            for lane in lanes.iter_mut() {
-                scope.spawn(move || {
-                    let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass)
-                        .with_end_change(&mut lane.end_change);
-                    for slot in lane.slots.clone() {
-                        let view = IslandView::of(set, solved[slot]);
-                        project_met(
-                            view,
-                            &mut own,
-                            dt,
-                            settings,
-                            &mut lane.scratch,
-                            &mut lane.stats,
-                            &mut lane.impulse,
-                        );
-                    }
-                });
-            }
-            for slot in first {
-                let view = IslandView::of(set, solved[slot]);
-                project_met(view, bodies, dt, settings, scratch, stats, impulse);
-            }
-        });
+        alongside(
+            lanes,
+            |lane| {
+                let mut own = Bodies::new(position, &mut lane.velocity, inverse_mass)
+                    .with_end_change(&mut lane.end_change);
+                for slot in lane.slots.clone() {
+                    let view = IslandView::of(set, solved[slot]);
+                    project_met(
+                        view,
+                        &mut own,
+                        dt,
+                        settings,
+                        &mut lane.scratch,
+                        &mut lane.stats,
+                        &mut lane.impulse,
+                    );
+                }
+            },
+            || {
+                for slot in first {
+                    let view = IslandView::of(set, solved[slot]);
+                    project_met(view, bodies, dt, settings, scratch, stats, impulse);
+                }
+            },
+        );
         // Each lane's islands' velocities back; a pinned particle two islands share is
         // never written, so its copy is the value it had.
         for lane in lanes.iter() {

@@ -70,11 +70,7 @@ fn slots(
 
 /// Join a live row's members into one acting set.
 fn join(sets: &mut UnionFind, acting: &mut [bool], members: [Option<usize>; 3]) {
-    let mut members = members.into_iter().flatten();
-    if let Some(first) = members.next() {
-        for other in members {
-            sets.union(first, other);
-        }
+    if let Some(first) = sets.union_all(members.into_iter().flatten()) {
         acting[first] = true;
     }
 }

@@ -18,6 +18,7 @@ use crate::constraints::islands::IslandSet;
 use crate::constraints::projection::{Bodies, ProjectionOutcome};
 use crate::metrics::IterationStats;
 use crate::model::NO_ISLAND;
+use crate::parallel::alongside;
 
 /// Below this many rows a contact projection stays on one thread.
 const PARALLEL_ROWS: usize = 512;
@@ -146,42 +147,7 @@ impl GroupDriver {
                 dt,
                 settings,
             };
-            let (first, rest) = self.lanes[..lanes].split_at_mut(1);
-            let first = &mut first[0];
-            if rest.is_empty() {
-                first.run(&shared, bodies.reborrow());
-            } else {
-                let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
-                self.before.clear();
-                self.before.extend_from_slice(bodies.velocity);
-                for lane in rest.iter_mut() {
-                    lane.velocity.clear();
-                    lane.velocity.extend_from_slice(bodies.velocity);
-                }
-                let shared = &shared;
-                std::thread::scope(|scope| {
-                    for lane in rest.iter_mut() {
-                        scope.spawn(move || {
-                            let mut velocity = std::mem::take(&mut lane.velocity);
-                            lane.run(shared, Bodies::new(position, &mut velocity, inverse_mass));
-                            lane.velocity = velocity;
-                        });
-                    }
-                    first.run(shared, bodies.reborrow());
-                });
-                // Each particle is projected by one lane at most: copy what the others changed.
-                let bits = |v: &DVec2| v.to_array().map(f64::to_bits);
-                for lane in rest.iter() {
-                    for ((v, own), before) in (bodies.velocity.iter_mut())
-                        .zip(&lane.velocity)
-                        .zip(&self.before)
-                    {
-                        if bits(own) != bits(before) {
-                            *v = *own;
-                        }
-                    }
-                }
-            }
+            Self::run_lanes(&mut self.lanes[..lanes], &mut self.before, &shared, bodies);
         }
         // A row that touches no member carries nothing.
         for (slot, &group) in impulses.iter_mut().zip(&self.groups.row_group) {
@@ -189,7 +155,64 @@ impl GroupDriver {
                 *slot = RowImpulse::default();
             }
         }
-        // Merge in group order: the same sums in the same order whatever the lanes.
+        self.merge(lanes, impulses, edge_impulse, outcomes, stats)
+    }
+
+    /// Project each lane's groups, the first lane's on this thread and each other's on
+    /// a thread of its own with its own copy of the velocities, then copy back what
+    /// each changed (a particle is projected by one lane at most).
+    fn run_lanes(
+        lanes: &mut [Lane],
+        before: &mut Vec<DVec2>,
+        shared: &Shared,
+        bodies: &mut Bodies,
+    ) {
+        let (first, rest) = lanes.split_at_mut(1);
+        let first = &mut first[0];
+        if rest.is_empty() {
+            first.run(shared, bodies.reborrow());
+        } else {
+            let (position, inverse_mass) = (bodies.position, bodies.inverse_mass);
+            before.clear();
+            before.extend_from_slice(bodies.velocity);
+            for lane in rest.iter_mut() {
+                lane.velocity.clear();
+                lane.velocity.extend_from_slice(bodies.velocity);
+            }
+            alongside(
+                rest,
+                |lane| {
+                    let mut velocity = std::mem::take(&mut lane.velocity);
+                    lane.run(shared, Bodies::new(position, &mut velocity, inverse_mass));
+                    lane.velocity = velocity;
+                },
+                || first.run(shared, bodies.reborrow()),
+            );
+            // Each particle is projected by one lane at most: copy what the others changed.
+            let bits = |v: &DVec2| v.to_array().map(f64::to_bits);
+            for lane in rest.iter() {
+                for ((v, own), before) in (bodies.velocity.iter_mut())
+                    .zip(&lane.velocity)
+                    .zip(before.iter())
+                {
+                    if bits(own) != bits(before) {
+                        *v = *own;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The lanes' results merged in group order: the same sums in the same order
+    /// whatever the lanes.
+    fn merge(
+        &self,
+        lanes: usize,
+        impulses: &mut [RowImpulse],
+        edge_impulse: &mut [f64],
+        outcomes: &mut Vec<(u32, bool)>,
+        stats: &mut IterationStats,
+    ) -> ContactOutcome {
         let mut total = ContactOutcome {
             converged: true,
             ..Default::default()

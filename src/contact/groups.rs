@@ -36,12 +36,8 @@ impl ContactGroups {
     pub fn partition(&mut self, slots: usize, rows: &[RowSlots]) {
         self.sets.reset(slots);
         for row in rows {
-            let mut members = row.iter().copied().filter(|&s| s != NONE);
-            if let Some(first) = members.next() {
-                for other in members {
-                    self.sets.union(first as usize, other as usize);
-                }
-            }
+            let members = row.iter().filter(|&&s| s != NONE).map(|&s| s as usize);
+            self.sets.union_all(members);
         }
         // A set is named by its smallest slot, so numbering roots in slot order gives
         // the same numbers whatever the order of the rows.

@@ -185,6 +185,29 @@ impl GroupSolve {
 }
 
 impl ContactRows {
+    /// Remember the impulses for the next step's rows of the same pairs, and the
+    /// contacts that took one (into `speculated`).
+    fn remember(&mut self, speculated: &mut Vec<Contact>) {
+        self.warm.clear();
+        // As large as the keys' buffer: they grow when it does, not at a later step.
+        let room = self.keys.capacity();
+        self.warm.reserve(room.saturating_sub(self.warm.len()));
+        speculated.reserve(room.saturating_sub(speculated.len()));
+        let rows = self.keys.iter().zip(&self.impulses).zip(&self.rows);
+        for ((&(p, key, edge), impulse), row) in rows {
+            if impulse.normal > 0.0 {
+                self.warm.push((p, key, *impulse));
+                speculated.push(Contact {
+                    p,
+                    edge,
+                    alpha: -row.coefficients[2],
+                    normal: row.normal,
+                });
+            }
+        }
+        self.warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
+    }
+
     fn warm_start(&self, p: u32, key: u32) -> RowImpulse {
         self.warm
             .binary_search_by_key(&(p, key), |&(q, k, _)| (q, k))
@@ -285,33 +308,7 @@ pub fn speculate(
         collider.settings.threads,
         Some(ACTING_MARGIN * thickness),
     );
-    // Remember the impulses for the next step's rows of the same pairs, and the
-    // contacts that took one.
-    buffers.warm.clear();
-    // As large as the keys' buffer: they grow when it does, not at a later step.
-    let room = buffers.keys.capacity();
-    buffers
-        .warm
-        .reserve(room.saturating_sub(buffers.warm.len()));
-    let speculated = &mut collider.scratch.speculated;
-    speculated.reserve(room.saturating_sub(speculated.len()));
-    let rows = buffers
-        .keys
-        .iter()
-        .zip(&buffers.impulses)
-        .zip(&buffers.rows);
-    for ((&(p, key, edge), impulse), row) in rows {
-        if impulse.normal > 0.0 {
-            buffers.warm.push((p, key, *impulse));
-            collider.scratch.speculated.push(Contact {
-                p,
-                edge,
-                alpha: -row.coefficients[2],
-                normal: row.normal,
-            });
-        }
-    }
-    buffers.warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
+    buffers.remember(&mut collider.scratch.speculated);
     for &(island, met) in &buffers.outcomes {
         if !met {
             islands.project_alone(

@@ -26,15 +26,16 @@
 use bevy::math::DVec2;
 
 use super::rows::{ContactRow, RowImpulse};
-use super::scratch::{ContactScratch, LOOSE, NOT_LOCAL, Part, measure_edges};
+use super::scratch::{ContactScratch, LOOSE, NOT_LOCAL, Part, measure_edges, within_trust};
 use super::settings::{ContactOutcome, ContactSettings, ContactSolver, Resting};
 use super::split::Members;
 use super::sweeps::{Sweeps, localize_rows};
 use crate::constraints::island_edge::IslandEdge;
 use crate::constraints::islands::IslandSet;
+use crate::constraints::projection::edge;
 use crate::constraints::projection::scratch::Factors;
 use crate::constraints::projection::view::{Bodies, IslandView};
-use crate::constraints::projection::walk::{ChainWalk, GraphWalk, Walk};
+use crate::constraints::projection::walk::{Walk, with_walk};
 use crate::constraints::projection::{ConstraintDirection, ROUND_OFF_FLOOR};
 
 /// Edge residual (`|C| / L²`) below which the rows may be frozen and the edges
@@ -95,7 +96,7 @@ pub fn project_with_contacts(
         }),
         _ => None,
     };
-    let outcome = iterate(set, islands, settings, resting.as_ref(), scratch);
+    let outcome = newton_steps(set, islands, settings, resting.as_ref(), scratch);
     // Apply: a part whose corrections are absurd (nearly dependent rows asking for a
     // lever's swing) keeps its velocities.
     let limit = settings.max_correction;
@@ -192,32 +193,18 @@ fn lay_out(
             });
             continue;
         };
-        match IslandView::of(set, island as usize) {
-            IslandView::Chain(chain) => lay_out_island(
+        with_walk!(IslandView::of(set, island as usize), |edges, walk| {
+            lay_out_island(
                 i as u32,
-                chain.edges,
-                ChainWalk {
-                    closed: chain.closed,
-                },
+                edges,
+                walk,
                 position,
                 velocity,
                 inverse_mass,
                 dt,
                 s,
-            ),
-            IslandView::Graph(graph) => lay_out_island(
-                i as u32,
-                graph.edges,
-                GraphWalk {
-                    layout: graph.layout,
-                },
-                position,
-                velocity,
-                inverse_mass,
-                dt,
-                s,
-            ),
-        }
+            )
+        })
     }
     s.incident_start.push(s.incident.len() as u32);
     let (n, m) = (s.packed.len(), s.ends.len());
@@ -275,8 +262,8 @@ fn lay_out_island<W: Walk>(
         let predicted = position[b] - position[a] + dt * (velocity[b] - velocity[a]);
         s.predicted_edge.push(predicted);
         s.rest_squared.push(e.rest_length * e.rest_length);
-        let w = inverse_mass[a] + inverse_mass[b];
-        s.locked.push(predicted.length_squared() * w <= 0.0);
+        s.locked
+            .push(edge::locked(predicted, inverse_mass[a] + inverse_mass[b]));
         shortest = shortest.min(e.rest_length);
     }
     for j in 0..particles {
@@ -296,7 +283,7 @@ fn lay_out_island<W: Walk>(
 }
 
 /// The Newton iterations from Δ = 0 with the localized rows.
-fn iterate(
+fn newton_steps(
     set: &IslandSet,
     islands: &[u32],
     settings: &ContactSettings,
@@ -319,15 +306,11 @@ fn iterate(
     }
     let contact_tolerance = settings.contact_tolerance;
     let mut previous_violation = f64::INFINITY;
-    let shortest = s
-        .parts
-        .iter()
-        .map(|p| p.shortest)
-        .fold(f64::INFINITY, f64::min);
+    let shortest = s.shortest_edge();
     let trust = 0.5 * shortest;
     loop {
         let residual = measure_edges(s);
-        let violation = Sweeps::violation(s);
+        let violation = Sweeps::shortfall(s);
         outcome.residual = residual;
         outcome.contact_violation = violation;
         // The polish moves particles by about the residual times an edge: the rows are
@@ -372,8 +355,8 @@ fn iterate(
             .zip(&s.step_start)
             .map(|(c, start)| (*c - *start).length())
             .fold(0.0f64, f64::max);
-        let shrink = if rows_active && longest > trust {
-            trust / longest
+        let shrink = if rows_active {
+            within_trust(longest, trust)
         } else {
             1.0
         };
@@ -406,22 +389,10 @@ fn edge_step(set: &IslandSet, islands: &[u32], s: &mut ContactScratch) {
         if part.island == LOOSE || part.edges.1 == 0 {
             continue;
         }
-        let solved = match IslandView::of(set, islands[part.island as usize] as usize) {
-            IslandView::Chain(chain) => solve_part(
-                p,
-                ChainWalk {
-                    closed: chain.closed,
-                },
-                s,
-            ),
-            IslandView::Graph(graph) => solve_part(
-                p,
-                GraphWalk {
-                    layout: graph.layout,
-                },
-                s,
-            ),
-        };
+        let solved = with_walk!(
+            IslandView::of(set, islands[part.island as usize] as usize),
+            |_, walk| solve_part(p, walk, s)
+        );
         if !solved {
             s.parts[p].singular = true;
         }
@@ -460,8 +431,12 @@ fn solve_part<W: Walk>(p: usize, walk: W, s: &mut ContactScratch) -> bool {
     for k in first_edge..first_edge + m {
         let impulse = 2.0 * s.edge_multiplier[k] * s.edge[k];
         let (a, b) = s.ends[k];
-        s.base[a as usize] -= s.inverse_mass[a as usize] * impulse;
-        s.base[b as usize] += s.inverse_mass[b as usize] * impulse;
+        edge::apply(
+            &mut s.base,
+            &s.inverse_mass,
+            (a as usize, b as usize),
+            impulse,
+        );
     }
     true
 }

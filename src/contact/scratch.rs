@@ -6,6 +6,7 @@ use bevy::math::DVec2;
 use super::local_row::LocalRow;
 use super::newton::scratch::NewtonScratch;
 use super::split::RowCut;
+use crate::constraints::projection::edge;
 use crate::constraints::projection::scratch::{Factors, IslandScratch};
 
 /// One part of the contact problem: an island, or a loose free particle (no edges).
@@ -98,6 +99,13 @@ pub(super) struct Bank {
 }
 
 impl ContactScratch {
+    /// The shortest rest length of the projection's edges (infinite with none).
+    pub(super) fn shortest_edge(&self) -> f64 {
+        (self.parts.iter())
+            .map(|p| p.shortest)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Let the sweeps of a cut projection run its two sides at once when `threads` is
     /// more than one (the result is the same whatever the count).
     pub fn set_threads(&mut self, threads: usize) {
@@ -121,6 +129,17 @@ impl ContactScratch {
     }
 }
 
+/// The trust region of a Newton step: no particle moves more than half the shortest edge
+/// of the projection (`trust`); the fraction of a step whose longest move is `longest`
+/// that stays inside it.
+pub(super) fn within_trust(longest: f64, trust: f64) -> f64 {
+    if longest > trust {
+        trust / longest
+    } else {
+        1.0
+    }
+}
+
 /// The edges at the current corrections, their constraint values and each part's
 /// residual; returns the largest.
 pub(super) fn measure_edges(s: &mut ContactScratch) -> f64 {
@@ -130,9 +149,9 @@ pub(super) fn measure_edges(s: &mut ContactScratch) -> f64 {
         let mut residual = 0.0f64;
         for k in first..first + count {
             let (a, b) = s.ends[k];
-            let d = s.predicted_edge[k] + (s.correction[b as usize] - s.correction[a as usize]);
-            s.edge[k] = d;
-            s.constraint[k] = d.length_squared() - s.rest_squared[k];
+            let (from, to) = (s.correction[a as usize], s.correction[b as usize]);
+            (s.edge[k], s.constraint[k]) =
+                edge::at(s.predicted_edge[k], from, to, s.rest_squared[k]);
             if !s.locked[k] {
                 residual = residual.max(s.constraint[k].abs() / s.rest_squared[k]);
             }

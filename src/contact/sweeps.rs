@@ -18,7 +18,7 @@ use super::scratch::{Bank, ContactScratch, LOOSE, NOT_LOCAL, Part};
 use crate::constraints::islands::IslandSet;
 use crate::constraints::projection::scratch::Factors;
 use crate::constraints::projection::view::IslandView;
-use crate::constraints::projection::walk::{ChainWalk, GraphWalk, Walk};
+use crate::constraints::projection::walk::{ChainWalk, Walk, with_walk};
 use crate::parallel::{Partner, with_partner};
 
 /// Translate `rows` into local rows in the cut's sweep order (a row with no free
@@ -146,26 +146,10 @@ fn row_responses(f: &Frame, bank: &mut Bank, row: &mut LocalRow) {
             link_responses(f, bank, row, link, None::<ChainWalk>);
             continue;
         }
-        match IslandView::of(f.set, f.islands[part.island as usize] as usize) {
-            IslandView::Chain(chain) => link_responses(
-                f,
-                bank,
-                row,
-                link,
-                Some(ChainWalk {
-                    closed: chain.closed,
-                }),
-            ),
-            IslandView::Graph(graph) => link_responses(
-                f,
-                bank,
-                row,
-                link,
-                Some(GraphWalk {
-                    layout: graph.layout,
-                }),
-            ),
-        }
+        with_walk!(
+            IslandView::of(f.set, f.islands[part.island as usize] as usize),
+            |_, walk| link_responses(f, bank, row, link, Some(walk))
+        );
     }
     let tangent = row.normal.perp();
     row.diag_n = stiffness(f, bank, row, Along::Normal, row.normal);
@@ -430,7 +414,7 @@ impl<'a> CutSweeps<'_, 'a> {
 impl Sweeps {
     /// How far (a distance per step) the most violated normal row falls short at the
     /// current corrections.
-    pub(super) fn violation(s: &ContactScratch) -> f64 {
+    pub(super) fn shortfall(s: &ContactScratch) -> f64 {
         let correction = s.correction.as_slice();
         s.rows
             .iter()

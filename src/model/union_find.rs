@@ -42,6 +42,17 @@ impl UnionFind {
         self.parent[merged] = keep as u32;
         Some((keep, merged))
     }
+
+    /// Join every one of `members` to the first (a contact row's members: one set);
+    /// returns the first, or `None` when there are none.
+    pub fn union_all(&mut self, members: impl IntoIterator<Item = usize>) -> Option<usize> {
+        let mut members = members.into_iter();
+        let first = members.next()?;
+        for other in members {
+            self.union(first, other);
+        }
+        Some(first)
+    }
 }
 
 #[cfg(test)]
@@ -56,6 +67,9 @@ mod tests {
         assert_eq!(sets.union(2, 5), None);
         assert_eq!(sets.find(5), 2);
         assert_eq!(sets.find(0), 0);
+        assert_eq!(sets.union_all([1, 3, 0]), Some(1));
+        assert_eq!(sets.find(3), 0);
+        assert_eq!(sets.union_all([]), None);
         sets.reset(3);
         assert_eq!(sets.find(2), 2);
     }

@@ -5,6 +5,7 @@
 
 use bevy::math::DVec2;
 
+use super::edge;
 use super::scratch::IslandScratch;
 use super::settings::{
     ConstraintDirection, ProjectionOutcome, ProjectionSettings, ROUND_OFF_FLOOR,
@@ -42,9 +43,13 @@ pub(super) fn iterate<W: Walk>(
         let mut residual = 0.0f64;
         for (k, e) in edges.iter().enumerate() {
             let (a, b) = walk.ends(k, particles);
-            s.edge[k] = s.predicted_edge[k] + (s.correction[b] - s.correction[a]);
             let rest_squared = e.rest_length * e.rest_length;
-            s.constraint[k] = s.edge[k].length_squared() - rest_squared;
+            (s.edge[k], s.constraint[k]) = edge::at(
+                s.predicted_edge[k],
+                s.correction[a],
+                s.correction[b],
+                rest_squared,
+            );
             if !s.locked[k] {
                 residual = residual.max(s.constraint[k].abs() / rest_squared);
             }
@@ -95,9 +100,12 @@ fn newton_step<W: Walk>(
     for (k, d) in direction.iter().enumerate() {
         let impulse = 2.0 * s.rhs[k] * *d;
         s.edge_impulse[k] -= 2.0 * s.rhs[k] * d.length();
-        let (a, b) = walk.ends(k, particles);
-        s.correction[a] -= s.inverse_mass[a] * impulse;
-        s.correction[b] += s.inverse_mass[b] * impulse;
+        edge::apply(
+            &mut s.correction,
+            &s.inverse_mass,
+            walk.ends(k, particles),
+            impulse,
+        );
     }
     Ok(())
 }

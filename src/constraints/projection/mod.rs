@@ -1,7 +1,7 @@
 //! Fast projection of an island onto its length constraints. A path or a loop has a
 //! tridiagonal
 //! system (Thomas; Sherman–Morrison for the loop's corners); a tree or a general graph
-//! a sparse one, factored by [`super::sparse`] in the order its layout planned.
+//! a sparse one, factored by [`crate::linalg::sparse`] in the order its layout planned.
 //!
 //! Per edge k from a to b, `C_k(x) = |x_b − x_a|² − L_k²`. Starting from the
 //! unconstrained end of step `x̃ = x + dt v*`, repeat: solve `A δ = −C(x̃)` with
@@ -25,7 +25,7 @@
 //!
 //! **Contacts.** The islands that contact rows touch are projected together with
 //! those rows by [`crate::contact`], which walks their edges with this module's
-//! [`walk`]s and factors them with its [`scratch`]'s factors.
+//! `walk`s and factors them with its `scratch`'s factors.
 //!
 //! A pure kernel: slices in, slices out, no allocation once the scratch is sized. One
 //! projection is in `project`, its Newton iterations in `iterate` (shared with each
@@ -33,6 +33,7 @@
 //! `assembly`.
 
 mod assembly;
+pub(crate) mod edge;
 mod iterate;
 mod project;
 mod restep;
@@ -48,7 +49,7 @@ pub use settings::{
 pub use view::{Bodies, Chain, Graph, IslandView};
 
 use project::project_walk;
-use walk::{ChainWalk, GraphWalk};
+use walk::with_walk;
 
 /// Project the velocities of one chain so that every edge ends the step at its rest
 /// length; see [`project_island`].
@@ -73,14 +74,9 @@ pub fn project_island(
     settings: &ProjectionSettings,
     scratch: &mut IslandScratch,
 ) -> ProjectionOutcome {
-    match island {
-        IslandView::Chain(Chain { edges, closed }) => {
-            project_walk(edges, ChainWalk { closed }, bodies, dt, settings, scratch)
-        }
-        IslandView::Graph(Graph { edges, layout }) => {
-            project_walk(edges, GraphWalk { layout }, bodies, dt, settings, scratch)
-        }
-    }
+    with_walk!(island, |edges, walk| {
+        project_walk(edges, walk, bodies, dt, settings, scratch)
+    })
 }
 
 #[cfg(test)]

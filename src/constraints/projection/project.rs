@@ -4,6 +4,7 @@
 
 use bevy::math::DVec2;
 
+use super::edge;
 use super::iterate::iterate;
 use super::restep::restep;
 use super::scratch::IslandScratch;
@@ -51,7 +52,7 @@ pub(super) fn project_walk<W: Walk>(
         scratch.predicted_edge[k] = scratch.start_direction[k] + dt * (velocity[b] - velocity[a]);
         let (ja, jb) = walk.ends(k, particles);
         let w = scratch.inverse_mass[ja] + scratch.inverse_mass[jb];
-        scratch.locked[k] = scratch.predicted_edge[k].length_squared() * w <= 0.0;
+        scratch.locked[k] = edge::locked(scratch.predicted_edge[k], w);
     }
     let locked = scratch.locked[..m].iter().filter(|&&l| l).count() as u32;
     scratch.edge_impulse[..m].fill(0.0);

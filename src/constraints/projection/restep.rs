@@ -15,6 +15,7 @@
 
 use bevy::math::DVec2;
 
+use super::edge;
 use super::iterate::iterate;
 use super::scratch::IslandScratch;
 use super::settings::{
@@ -133,7 +134,7 @@ fn filter_velocities<W: Walk>(
         let edge = position[e.b as usize] - position[e.a as usize];
         s.edge[k] = edge;
         s.start_direction[k] = edge;
-        s.locked[k] = edge.length_squared() * (s.inverse_mass[ja] + s.inverse_mass[jb]) <= 0.0;
+        s.locked[k] = edge::locked(edge, s.inverse_mass[ja] + s.inverse_mass[jb]);
         s.rhs[k] = if s.locked[k] {
             0.0
         } else {
@@ -142,10 +143,9 @@ fn filter_velocities<W: Walk>(
     }
     walk.solve(m, ConstraintDirection::EndOfStep, false, s)?;
     for k in 0..m {
-        let (ja, jb) = walk.ends(k, particles);
         let impulse = 2.0 * s.rhs[k] * s.edge[k];
-        s.substep_velocity[ja] -= s.inverse_mass[ja] * impulse;
-        s.substep_velocity[jb] += s.inverse_mass[jb] * impulse;
+        let ends = walk.ends(k, particles);
+        edge::apply(&mut s.substep_velocity, &s.inverse_mass, ends, impulse);
         s.substep_impulse[k] -= 2.0 * s.rhs[k] * s.edge[k].length() * dt;
     }
     Ok(())
@@ -172,7 +172,7 @@ fn substep<W: Walk>(
         s.start_direction[k] = start;
         s.predicted_edge[k] = start + h * (s.substep_velocity[jb] - s.substep_velocity[ja]);
         let w = s.inverse_mass[ja] + s.inverse_mass[jb];
-        s.locked[k] = s.predicted_edge[k].length_squared() * w <= 0.0;
+        s.locked[k] = edge::locked(s.predicted_edge[k], w);
     }
     s.edge_impulse[..m].fill(0.0);
     iterate(edges, walk, settings, s)

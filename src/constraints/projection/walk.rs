@@ -35,6 +35,31 @@ pub(crate) trait Walk: Copy {
     fn solve_many(self, m: usize, factors: &Factors, columns: &mut [f64], k: usize);
 }
 
+/// `$body` with `$edges` bound to an island's edges and `$walk` to its walk (a
+/// [`ChainWalk`] or a [`GraphWalk`]): the one dispatch on an island's kind, each arm
+/// compiled for its walk so the loops have no branch per edge.
+macro_rules! with_walk {
+    ($view:expr, |$edges:pat, $walk:ident| $body:expr) => {
+        match $view {
+            $crate::constraints::projection::IslandView::Chain(chain) => {
+                let $edges = chain.edges;
+                let $walk = $crate::constraints::projection::walk::ChainWalk {
+                    closed: chain.closed,
+                };
+                $body
+            }
+            $crate::constraints::projection::IslandView::Graph(graph) => {
+                let $edges = graph.edges;
+                let $walk = $crate::constraints::projection::walk::GraphWalk {
+                    layout: graph.layout,
+                };
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_walk;
+
 /// A path or a loop.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ChainWalk {

@@ -44,7 +44,7 @@ use self::line_search::Line;
 use self::scratch::NewtonScratch;
 use crate::constraints::projection::ROUND_OFF_FLOOR;
 use crate::contact::local_row::LocalRow;
-use crate::contact::scratch::{ContactScratch, measure_edges};
+use crate::contact::scratch::{ContactScratch, measure_edges, within_trust};
 use crate::contact::settings::{ContactOutcome, ContactSettings, ContactSolver};
 
 /// A row's contact stiffness over its own mass `1 / Σ cᵢ² wᵢ`: soft enough that a step
@@ -145,14 +145,14 @@ fn kkt_input<'a>(s: &'a ContactScratch, included: &'a [bool]) -> KktInput<'a> {
     }
 }
 
+/// The Newton iterations over the rows and edges of `s` (see the module doc), or `None`
+/// where `Auto` leaves them to the sweeps.
 fn run(
     settings: &ContactSettings,
     s: &mut ContactScratch,
     w: &mut NewtonScratch,
     outcome: &mut ContactOutcome,
 ) -> Option<bool> {
-    let n = s.packed.len();
-    let rows = s.rows.len();
     w.kkt.factorizations = 0;
     w.kkt.threads = s.threads;
     let links: usize = s.rows.iter().map(|row| row.link_count as usize).sum();
@@ -166,6 +166,94 @@ fn run(
     {
         return None;
     }
+    set_up(s, w);
+    if settings.solver == ContactSolver::Auto && sweeps_can && prefers_sweeps(swept, w.kkt.work()) {
+        return None;
+    }
+    let tolerance = settings.contact_tolerance;
+    let cap = settings.rows_give_way.max(1);
+    let trust = 0.5 * s.shortest_edge();
+    // Once the rows are met, the edges' polish moves particles by about the residual
+    // times an edge: no more than the contact tolerance.
+    let polish = (tolerance / (2.0 * trust)).clamp(ROUND_OFF_FLOOR, 1e-3);
+    let mut last_violation = f64::INFINITY;
+    let mut full_until = FULL_STEPS;
+    let mut met = false;
+    let mut best = (f64::INFINITY, 0);
+    let mut renewed = false;
+    for step in 0..cap {
+        set_correction(s, &w.momentum);
+        measure_edges(s);
+        choose_model(s, w, step == 0, renewed);
+        renewed = false;
+        let Some((alpha, longest)) = newton_step(s, w, trust, step < full_until, outcome) else {
+            break;
+        };
+        // A step whose part left untaken moves nothing that matters is taken whole.
+        let whole = (1.0 - alpha) * longest <= 1e-3 * tolerance;
+        let violation = coulomb_violation(s, w);
+        let holds = whole && model_holds(s, w, tolerance);
+        // Until the edges are nearly met, their next linearization moves the rows
+        // more than a shift would: solve again before judging the rows.
+        let settled = measure_edges(s) <= polish;
+        // Met: no row farther from Coulomb's law than the tolerance, and none pulling by
+        // more than would move it that far, whether or not the model's states hold.
+        met = violation <= tolerance && pull_at_most(s, w, tolerance);
+        if met && settled {
+            break;
+        }
+        // Past the whole steps, rows whose states still change (a degenerate cluster)
+        // but are within a few tolerances are as good as the sweeps left theirs: leave
+        // them once the edges' polish moves no more than that.
+        if step + 1 >= FULL_STEPS
+            && !holds
+            && violation <= CLOSE_ENOUGH * tolerance
+            && measure_edges(s) <= stalled_polish(violation, tolerance, trust)
+        {
+            break;
+        }
+        if !(holds && settled) {
+            // Rows that stop improving (a degenerate cluster trading impulses between
+            // cone edges that are combinations of each other) are left where they are
+            // once the edges are within what they fall short, as the sweeps' rows
+            // were: the polish then moves particles by no more than that.
+            if violation < 0.5 * best.0 {
+                best = (violation, step);
+            } else if step >= best.1 + STALL
+                && measure_edges(s) <= stalled_polish(violation, tolerance, trust)
+            {
+                break;
+            }
+            continue;
+        }
+        if met {
+            continue;
+        }
+        // The rows' give is over the tolerance (a heavy load on a light row): shift
+        // each row by its impulse and solve again. Rows that cannot all be met stall.
+        if violation > 0.5 * last_violation {
+            break;
+        }
+        last_violation = violation;
+        renew_shifts(s, w);
+        full_until = step + 1 + FULL_STEPS;
+        renewed = true;
+    }
+    finish(s, w, outcome);
+    Some(met)
+}
+
+/// How far the edges' polish may leave them when rows that stall are left as they are:
+/// about the residual times an edge (`2 trust`) moves particles no more than the rows
+/// fall short.
+fn stalled_polish(violation: f64, tolerance: f64, trust: f64) -> f64 {
+    (violation.max(tolerance) / (2.0 * trust)).min(1e-3)
+}
+
+/// The rows' stiffness and shifts (the warm start), the iterate's buffers, and the
+/// system's pattern numbered once for the projection.
+fn set_up(s: &ContactScratch, w: &mut NewtonScratch) {
+    let (n, rows) = (s.packed.len(), s.rows.len());
     w.stiffness.clear();
     w.shift.clear();
     for row in &s.rows {
@@ -204,169 +292,119 @@ fn run(
     w.included.clear();
     w.included.extend(w.stiffness.iter().map(|&k| k > 0.0));
     w.kkt.number(&kkt_input(s, &w.included));
-    if settings.solver == ContactSolver::Auto && sweeps_can && prefers_sweeps(swept, w.kkt.work()) {
+}
+
+/// One Newton step from the iterate in `w`: factor the system at the current edges,
+/// solve for the full step and for the edges alone, and move along the line between
+/// them (whole, `whole`, or to the line search's minimum), within `trust` of a
+/// particle's motion. Returns the step taken (`alpha`) and the longest particle move
+/// of the full step, or `None` where the factorization failed.
+fn newton_step(
+    s: &mut ContactScratch,
+    w: &mut NewtonScratch,
+    trust: f64,
+    whole: bool,
+    outcome: &mut ContactOutcome,
+) -> Option<(f64, f64)> {
+    let n = s.packed.len();
+    let rows = s.rows.len();
+    let unknowns = w.kkt.unknowns();
+    // Taut edges' curvature (tension over length) makes the steps Newton's on the
+    // manifold the edges allow, not on its tangent plane; slack ones are left out,
+    // so the system stays quasi-definite.
+    w.curvature.clear();
+    (w.curvature).extend(
+        w.tension
+            .iter()
+            .zip(&s.edge)
+            .map(|(&t, d)| t.max(0.0) / d.length()),
+    );
+    if (w.kkt)
+        .assemble_and_factor(&kkt_input(s, &w.included), &w.model, &s.edge, &w.curvature)
+        .is_err()
+    {
         return None;
     }
-    let tolerance = settings.contact_tolerance;
-    let cap = settings.rows_give_way.max(1);
-    let trust = 0.5
-        * s.parts
-            .iter()
-            .map(|p| p.shortest)
-            .fold(f64::INFINITY, f64::min);
-    // Once the rows are met, the edges' polish moves particles by about the residual
-    // times an edge: no more than the contact tolerance.
-    let polish = (tolerance / (2.0 * trust)).clamp(ROUND_OFF_FLOOR, 1e-3);
-    let mut last_violation = f64::INFINITY;
-    let mut full_until = FULL_STEPS;
-    let mut met = false;
-    let mut best = (f64::INFINITY, 0);
-    let mut renewed = false;
-    for step in 0..cap {
-        set_correction(s, &w.momentum);
-        measure_edges(s);
-        choose_model(s, w, step == 0, renewed);
-        renewed = false;
-        let unknowns = w.kkt.unknowns();
-        // Taut edges' curvature (tension over length) makes the steps Newton's on the
-        // manifold the edges allow, not on its tangent plane; slack ones are left out,
-        // so the system stays quasi-definite.
-        w.curvature.clear();
-        (w.curvature).extend(
-            w.tension
-                .iter()
-                .zip(&s.edge)
-                .map(|(&t, d)| t.max(0.0) / d.length()),
-        );
-        if (w.kkt)
-            .assemble_and_factor(&kkt_input(s, &w.included), &w.model, &s.edge, &w.curvature)
-            .is_err()
-        {
-            break;
-        }
-        outcome.iterations += 1;
-        w.whole = step < full_until;
-        right_hand_sides(s, w, unknowns);
-        w.kkt.solve(&mut w.full);
-        w.kkt.solve(&mut w.feasible);
-        lines(s, w);
-        // The line: its start (the edges met) and the way to the full step's end.
-        set_correction(s, &w.start);
-        let mut mass = (0.0, 0.0);
-        let mut longest = 0.0f64;
-        for j in 0..n {
-            let b = s.inverse_mass[j] * w.step[j];
-            mass.0 += w.start[j].dot(b);
-            mass.1 += w.step[j].dot(b);
-            longest = longest.max(b.length());
-        }
-        shifted_values(s, w);
-        set_correction(s, &w.step);
-        w.slope.clear();
-        for row in &s.rows {
-            let (a, b) = row_motion(row, &s.correction);
-            let e = cone(row.friction);
-            w.slope.push(e.map(|e| e.0 * a + e.1 * b));
-        }
-        let high = if longest > trust {
-            trust / longest
-        } else {
-            1.0
-        };
-        let line = Line {
-            rows: &s.rows,
-            stiffness: &w.stiffness,
-            value: &w.value,
-            slope: &w.slope,
-            mass,
-        };
-        // Whole steps first, so that the rows' states follow the iterate several at
-        // once; then a line search, which may stop at the first stiff row a step
-        // presses but never goes uphill.
-        let alpha = if w.whole { high } else { line.minimize(high) };
-        w.ahead.clear();
-        if alpha < 1.0 {
-            let ahead = w.value.iter().zip(&w.slope);
-            w.ahead
-                .extend(ahead.map(|(v, d)| [v[0] + d[0], v[1] + d[1]]));
-        }
-        for j in 0..n {
-            w.momentum[j] = w.start[j] + alpha * w.step[j];
-        }
-        for r in 0..rows {
-            for e in 0..2 {
-                w.lambda[r][e] = w.start_lambda[r][e] + alpha * w.step_lambda[r][e];
-            }
-        }
-        for k in 0..s.ends.len() {
-            w.tension[k] = w.start_tension[k] + alpha * w.step_tension[k];
-        }
-        set_correction(s, &w.momentum);
-        // A step whose part left untaken moves nothing that matters is taken whole.
-        let whole = (1.0 - alpha) * longest <= 1e-3 * tolerance;
-        let violation = violation(s, w);
-        let holds = whole && model_holds(s, w, tolerance);
-        // Until the edges are nearly met, their next linearization moves the rows
-        // more than a shift would: solve again before judging the rows.
-        let settled = measure_edges(s) <= polish;
-        // Met: no row farther from Coulomb's law than the tolerance, and none pulling by
-        // more than would move it that far, whether or not the model's states hold.
-        met = violation <= tolerance && pull_at_most(s, w, tolerance);
-        if met && settled {
-            break;
-        }
-        // Past the whole steps, rows whose states still change (a degenerate cluster)
-        // but are within a few tolerances are as good as the sweeps left theirs: leave
-        // them once the edges' polish moves no more than that.
-        if step + 1 >= FULL_STEPS
-            && !holds
-            && violation <= CLOSE_ENOUGH * tolerance
-            && measure_edges(s) <= (violation.max(tolerance) / (2.0 * trust)).min(1e-3)
-        {
-            break;
-        }
-        if !(holds && settled) {
-            // Rows that stop improving (a degenerate cluster trading impulses between
-            // cone edges that are combinations of each other) are left where they are
-            // once the edges are within what they fall short, as the sweeps' rows
-            // were: the polish then moves particles by no more than that.
-            if violation < 0.5 * best.0 {
-                best = (violation, step);
-            } else if step >= best.1 + STALL
-                && measure_edges(s) <= (violation.max(tolerance) / (2.0 * trust)).min(1e-3)
-            {
-                break;
-            }
-            continue;
-        }
-        if met {
-            continue;
-        }
-        // The rows' give is over the tolerance (a heavy load on a light row): shift
-        // each row by its impulse and solve again. Rows that cannot all be met stall.
-        if violation > 0.5 * last_violation {
-            break;
-        }
-        last_violation = violation;
-        // A sliding row is lifted by what the cone asked of it, μ |u_t| (Tasora and
-        // Anitescu's fixed point): solved again, it slides on its target, not above.
-        for (r, row) in s.rows.iter().enumerate() {
-            let [a, b] = w.pressed[r];
-            w.lift[r] = if a != b {
-                row.friction * row_values(row, &s.correction).1.abs()
-            } else {
-                0.0
-            };
-        }
-        for (r, shift) in w.shift.iter_mut().enumerate() {
-            let k = w.stiffness[r];
-            if k > 0.0 {
-                *shift = w.lambda[r].map(|l| l.max(0.0) / k);
-            }
-        }
-        full_until = step + 1 + FULL_STEPS;
-        renewed = true;
+    outcome.iterations += 1;
+    w.whole = whole;
+    right_hand_sides(s, w, unknowns);
+    w.kkt.solve(&mut w.full);
+    w.kkt.solve(&mut w.feasible);
+    lines(s, w);
+    // The line: its start (the edges met) and the way to the full step's end.
+    set_correction(s, &w.start);
+    let mut mass = (0.0, 0.0);
+    let mut longest = 0.0f64;
+    for j in 0..n {
+        let b = s.inverse_mass[j] * w.step[j];
+        mass.0 += w.start[j].dot(b);
+        mass.1 += w.step[j].dot(b);
+        longest = longest.max(b.length());
     }
+    shifted_values(s, w);
+    set_correction(s, &w.step);
+    w.slope.clear();
+    for row in &s.rows {
+        let (a, b) = row_motion(row, &s.correction);
+        let e = cone(row.friction);
+        w.slope.push(e.map(|e| e.0 * a + e.1 * b));
+    }
+    let high = within_trust(longest, trust);
+    let line = Line {
+        rows: &s.rows,
+        stiffness: &w.stiffness,
+        value: &w.value,
+        slope: &w.slope,
+        mass,
+    };
+    // Whole steps first, so that the rows' states follow the iterate several at
+    // once; then a line search, which may stop at the first stiff row a step
+    // presses but never goes uphill.
+    let alpha = if w.whole { high } else { line.minimize(high) };
+    w.ahead.clear();
+    if alpha < 1.0 {
+        let ahead = w.value.iter().zip(&w.slope);
+        w.ahead
+            .extend(ahead.map(|(v, d)| [v[0] + d[0], v[1] + d[1]]));
+    }
+    for j in 0..n {
+        w.momentum[j] = w.start[j] + alpha * w.step[j];
+    }
+    for r in 0..rows {
+        for e in 0..2 {
+            w.lambda[r][e] = w.start_lambda[r][e] + alpha * w.step_lambda[r][e];
+        }
+    }
+    for k in 0..s.ends.len() {
+        w.tension[k] = w.start_tension[k] + alpha * w.step_tension[k];
+    }
+    set_correction(s, &w.momentum);
+    Some((alpha, longest))
+}
+
+/// Renew the rows' shifts at their impulses, and lift each sliding row by what the
+/// cone asked of it.
+fn renew_shifts(s: &ContactScratch, w: &mut NewtonScratch) {
+    // A sliding row is lifted by what the cone asked of it, μ |u_t| (Tasora and
+    // Anitescu's fixed point): solved again, it slides on its target, not above.
+    for (r, row) in s.rows.iter().enumerate() {
+        let [a, b] = w.pressed[r];
+        w.lift[r] = if a != b {
+            row.friction * row_values(row, &s.correction).1.abs()
+        } else {
+            0.0
+        };
+    }
+    for (r, shift) in w.shift.iter_mut().enumerate() {
+        let k = w.stiffness[r];
+        if k > 0.0 {
+            *shift = w.lambda[r].map(|l| l.max(0.0) / k);
+        }
+    }
+}
+
+/// The result: each row's impulses, the edges' tensions added to their impulses.
+fn finish(s: &mut ContactScratch, w: &NewtonScratch, outcome: &mut ContactOutcome) {
     // Each row's impulses; a cone edge the last step left pulling keeps it (it is in
     // Δ), but carries none into the next step's warm start.
     for (row, lambda) in s.rows.iter_mut().zip(&w.lambda) {
@@ -376,7 +414,6 @@ fn run(
         *impulse += tension;
     }
     outcome.factorizations += w.kkt.factorizations;
-    Some(met)
 }
 
 /// A row's warm cone impulses from its (normal, tangent) warm start, inside the cone.
@@ -597,7 +634,7 @@ fn pull_at_most(s: &ContactScratch, w: &NewtonScratch, distance: f64) -> bool {
 /// How far (a distance per step) the rows are from Coulomb's law at the iterate: a row
 /// short of its target, a pressed one clear of it (the convex cone lifts a sliding
 /// contact by μ times its sliding), a sticking one sliding.
-fn violation(s: &ContactScratch, w: &NewtonScratch) -> f64 {
+fn coulomb_violation(s: &ContactScratch, w: &NewtonScratch) -> f64 {
     let mut worst = 0.0f64;
     for (r, row) in s.rows.iter().enumerate() {
         if w.stiffness[r] == 0.0 {

@@ -124,11 +124,20 @@ impl SupernodalPlan {
     pub fn plan(&mut self, p: &LdlPattern) {
         let n = p.len();
         self.n = n;
-        let parent = p.parent();
         p.column_counts_into(&mut self.count);
+        let nodes = self.fundamental(p.parent());
+        self.rows_below(p, nodes);
+        self.amalgamate(nodes);
+        self.lay_out(nodes);
+        self.place_in_parents();
+        self.split = split::choose(self);
+    }
+
+    /// Fundamental supernodes: column j joins j − 1 when j − 1's only parent is j, j
+    /// has no other child, and their structures nest. Returns how many.
+    fn fundamental(&mut self, parent: &[u32]) -> usize {
+        let n = self.n;
         let w = &mut self.work;
-        // Fundamental supernodes: column j joins j − 1 when j − 1's only parent is j,
-        // j has no other child, and their structures nest.
         w.children.clear();
         w.children.resize(n, 0);
         for &q in parent {
@@ -150,9 +159,16 @@ impl SupernodalPlan {
         }
         let nodes = w.node_start.len();
         w.node_start.push(n as u32);
+        nodes
+    }
+
+    /// Each supernode's rows below its columns (the matrix's, then its children's) and
+    /// its parent in the supernodal tree.
+    fn rows_below(&mut self, p: &LdlPattern, nodes: usize) {
         // Each supernode's rows below its columns: the matrix's, then its children's
         // (children come first in column order; each is listed under its parent).
         self.lower(p);
+        let n = p.len();
         let w = &mut self.work;
         w.below_start.clear();
         w.below.clear();
@@ -199,6 +215,12 @@ impl SupernodalPlan {
             }
             w.below_start.push(w.below.len() as u32);
         }
+    }
+
+    /// Relaxed amalgamation: a supernode whose columns just precede its parent's joins
+    /// it when the zeros that adds are few. Wider fronts make fewer, denser loops.
+    fn amalgamate(&mut self, nodes: usize) {
+        let w = &mut self.work;
         // Relaxed amalgamation: a supernode whose columns just precede its parent's
         // joins it when the zeros that adds are few (its columns then take its
         // parent's rows). Wider fronts make fewer, denser loops.
@@ -262,6 +284,11 @@ impl SupernodalPlan {
                 w.head[q as usize] = s as u32;
             }
         }
+    }
+
+    /// The supernodes in a postorder of their tree, laid out: columns, rows, panels.
+    fn lay_out(&mut self, nodes: usize) {
+        let w = &mut self.work;
         // Postorder of the supernodal tree.
         w.order.clear();
         w.stack.clear();
@@ -313,6 +340,12 @@ impl SupernodalPlan {
             self.largest = self.largest.max(m);
         }
         self.panel.push(panel);
+    }
+
+    /// Where each supernode's rows below sit in its parent's front, and the most the
+    /// update stack holds.
+    fn place_in_parents(&mut self) {
+        let w = &mut self.work;
         // Where each supernode's rows below sit in its parent's front, and the most
         // the update stack holds (children's updates wait for their parent).
         self.relative.clear();
@@ -342,7 +375,6 @@ impl SupernodalPlan {
             held += b * b;
             self.stack = self.stack.max(held);
         }
-        self.split = split::choose(self);
     }
 
     /// The matrix's lower triangle by column, from the upper pattern of `p`.
