@@ -389,6 +389,13 @@ pub fn contact_loop(
 
 /// Project the islands the contacts touched onto their constraints again, with the
 /// contacts as rows that must not approach, and record which met their edges.
+///
+/// Its rows are built here, not by [`speculative_rows`], on purpose: they come after
+/// the collision stage's impulses, which already took friction and the approach
+/// speed, so each only asks its pair not to come closer than it now is (or than
+/// `keep`) — no friction, no cushion target — for every contact the impulses met and
+/// every pair already within `reach`, where the speculative rows are one per point and
+/// strand for the motion the step predicts.
 fn reproject(
     collider: &mut Collider,
     contact: &ContactConfig,

@@ -258,7 +258,7 @@ impl Kkt {
         }
     }
 
-    /// Every (column, row) the matrix fills, in the order [`Kkt::assemble`] writes
+    /// Every (column, row) the matrix fills, in the order [`Kkt::assemble_and_factor`] writes
     /// them, and the pattern they make (duplicates are summed by the factorization).
     fn contributions(&mut self, input: &KktInput) {
         let c = &mut self.contribution;
