@@ -49,7 +49,7 @@ use crate::world::strand::{Strand, StrandOf};
 /// at 5–20 mm/s. Driven over this many ticks they come to rest; a frame nothing
 /// touches is driven in one (it pushes nothing, and stays within a millimetre of its
 /// body while it falls).
-const TOUCHED_FRAME_TICKS: f64 = 12.0;
+const TOUCHED_FRAME_TICKS: f64 = 24.0;
 
 /// A frame's net impulse over a tick (kg·m/s) above which strands touched it.
 const TOUCH_IMPULSE: f64 = 1e-9;
