@@ -8,7 +8,7 @@
 //! the contact projection of islands in contact ([`projection`]) and the relaxation baselines
 //! ([`relaxation`]); [`plugin`] holds the thin systems.
 //!
-//! Edge inextensibility only: nothing here knows about contacts ([`crate::contact`]
+//! Edge inextensibility only: nothing here knows about contacts (the `contact` module
 //! builds on it). Imports: [`crate::model`], [`crate::linalg`], [`crate::metrics`]; its
 //! plugin, [`crate::world`] and [`crate::schedule`].
 

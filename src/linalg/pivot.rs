@@ -2,8 +2,8 @@
 //! for a constraint that depends on those eliminated before it.
 //!
 //! A chain's tridiagonal system has no dependent edge, so a pivot near zero there is an
-//! error ([`usable`]). A tree's or graph's system (SPD, [`sparse`](super::sparse)) and
-//! the contact Newton's quasi-definite one ([`supernodal`](super::supernodal)) can hold
+//! error ([`usable`]). A tree's or graph's system (SPD, `sparse`) and
+//! the contact Newton's quasi-definite one (`supernodal`) can hold
 //! edges that are exact combinations of others (a braced square in 2D): such an edge's
 //! pivot is zero up to round-off, and its unknown is dropped (its multiplier is zero),
 //! so a consistent set of redundant constraints is still met by the others.

@@ -24,7 +24,7 @@
 //! end-of-step direction has no such limit.
 //!
 //! **Contacts.** The islands that contact rows touch are projected together with
-//! those rows by [`crate::contact`], which walks their edges with this module's
+//! those rows by the crate's `contact` module, which walks their edges with this module's
 //! `walk`s and factors them with its `scratch`'s factors.
 //!
 //! A pure kernel: slices in, slices out, no allocation once the scratch is sized. One
