@@ -119,20 +119,30 @@ fn the_built_in_pile_comes_to_rest_under_the_sweeps() {
 #[test]
 fn explicit_bending_on_short_edges_boils_at_a_games_step() {
     // The same coil with the explicit angle model: past its stability limit, the
-    // bends pump energy in and the rope never settles. The energy account sees it, and
-    // so does the guard, which freezes the rope with a message.
-    let (.., implicit, events) = settle(fine_coil(), 1.0 / 60.0, 4.0);
+    // bends pump energy in and the rope never settles; the energy account sees it.
+    // (The guard acts on energy no force explains by four times over: this boil stays
+    // under that since the contact solve's trust region follows the edges' spans, and
+    // the guard is tested on a pump of its own in tests/reliability.rs.)
+    let (calm, _, implicit, events) = settle(fine_coil(), 1.0 / 60.0, 4.0);
     assert!(events.is_empty(), "{events:?}");
     let mut scenario = fine_coil();
     scenario.step.bending = BendingModel::AngleExplicit;
-    let (_, _, explicit, events) = settle(scenario, 1.0 / 60.0, 4.0);
+    let (boiling, _, explicit, events) = settle(scenario, 1.0 / 60.0, 4.0);
     eprintln!(
-        "gained: implicit {} J, explicit {} J (start {:?} J); {events:?}",
+        "gained: implicit {} J, explicit {} J (start {:?} J); speeds {calm:?} / {boiling:?} m/s; {events:?}",
         implicit.largest_rise, explicit.largest_rise, implicit.start
     );
     assert!(
-        events.len() == 1 && events[0].quantity == bevy_strands::guard::Quantity::Speed,
+        events
+            .iter()
+            .all(|e| e.quantity == bevy_strands::guard::Quantity::Speed),
         "{events:?}"
+    );
+    // Median and 95th percentile speeds at the end (m/s): still at rest against boiling.
+    assert!(calm.0 < 1e-3 && calm.1 < 1e-2, "implicit {calm:?}");
+    assert!(
+        boiling.0 > 10.0 * calm.0 && boiling.1 > 0.1,
+        "explicit {boiling:?}, implicit {calm:?}"
     );
     assert!(
         explicit.largest_rise > 3.0 * implicit.largest_rise,

@@ -129,9 +129,19 @@ impl ContactScratch {
     }
 }
 
-/// The trust region of a Newton step: no particle moves more than half the shortest edge
-/// of the projection (`trust`); the fraction of a step whose longest move is `longest`
-/// that stays inside it.
+/// The largest change of an edge's span, `|motion(b) − motion(a)|` over the local edges
+/// `ends`, in a Newton step that moves each local particle `j` by `motion(j)`: what
+/// the step's linearization of that edge misses grows with it, while a strand carried
+/// whole (a landing stopped in one step) is linear in it.
+pub(super) fn longest_swing(ends: &[(u32, u32)], motion: impl Fn(usize) -> DVec2) -> f64 {
+    (ends.iter())
+        .map(|&(a, b)| (motion(b as usize) - motion(a as usize)).length())
+        .fold(0.0f64, f64::max)
+}
+
+/// The trust region of a Newton step: no edge's span changes by more than half the
+/// shortest edge of the projection (`trust`); the fraction of a step whose largest
+/// change is `longest` that stays inside it.
 pub(super) fn within_trust(longest: f64, trust: f64) -> f64 {
     if longest > trust {
         trust / longest
@@ -160,4 +170,36 @@ pub(super) fn measure_edges(s: &mut ContactScratch) -> f64 {
         largest = largest.max(residual);
     }
     largest
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_swing_counts_what_bends_an_edge_not_what_carries_it() {
+        let ends = [(0, 1), (1, 2)];
+        // Carried whole: no edge changes its span.
+        assert_eq!(longest_swing(&ends, |_| DVec2::new(0.3, -2.0)), 0.0);
+        // The middle particle pushed 1 mm sideways: both its edges change by 1 mm.
+        let bend = |j: usize| {
+            if j == 1 {
+                DVec2::new(0.0, 1e-3)
+            } else {
+                DVec2::ZERO
+            }
+        };
+        assert!((longest_swing(&ends, bend) - 1e-3).abs() < 1e-15);
+        // An end spun about the middle: its edge changes by the difference.
+        let spin = |j: usize| {
+            if j == 2 {
+                DVec2::new(-2e-3, 2e-3)
+            } else {
+                DVec2::ZERO
+            }
+        };
+        assert!((longest_swing(&ends, spin) - 8e-6f64.sqrt()).abs() < 1e-15);
+        assert_eq!(within_trust(4e-3, 2e-3), 0.5);
+        assert_eq!(within_trust(1e-3, 2e-3), 1.0);
+    }
 }

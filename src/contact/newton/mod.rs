@@ -44,7 +44,7 @@ use self::line_search::Line;
 use self::scratch::NewtonScratch;
 use crate::constraints::projection::ROUND_OFF_FLOOR;
 use crate::contact::local_row::LocalRow;
-use crate::contact::scratch::{ContactScratch, measure_edges, within_trust};
+use crate::contact::scratch::{ContactScratch, longest_swing, measure_edges, within_trust};
 use crate::contact::settings::{ContactOutcome, ContactSettings, ContactSolver};
 
 /// A row's contact stiffness over its own mass `1 / Σ cᵢ² wᵢ`: soft enough that a step
@@ -298,8 +298,8 @@ fn set_up(s: &ContactScratch, w: &mut NewtonScratch) {
 
 /// One Newton step from the iterate in `w`: factor the system at the current edges,
 /// solve for the full step and for the edges alone, and move along the line between
-/// them (whole, `whole`, or to the line search's minimum), within `trust` of a
-/// particle's motion. Returns the step taken (`alpha`) and the longest particle move
+/// them (whole, `whole`, or to the line search's minimum), no edge's span changing by
+/// more than `trust`. Returns the step taken (`alpha`) and the longest particle move
 /// of the full step, or `None` where the factorization failed.
 fn newton_step(
     s: &mut ContactScratch,
@@ -343,6 +343,8 @@ fn newton_step(
         mass.1 += w.step[j].dot(b);
         longest = longest.max(b.length());
     }
+    // The trust region bounds how the edges' spans change (see `within_trust`).
+    let swing = longest_swing(&s.ends, |j| s.inverse_mass[j] * w.step[j]);
     shifted_values(s, w);
     set_correction(s, &w.step);
     w.slope.clear();
@@ -351,7 +353,7 @@ fn newton_step(
         let e = cone(row.friction);
         w.slope.push(e.map(|e| e.0 * a + e.1 * b));
     }
-    let high = within_trust(longest, trust);
+    let high = within_trust(swing, trust);
     let line = Line {
         rows: &s.rows,
         stiffness: &w.stiffness,
