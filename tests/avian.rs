@@ -14,7 +14,7 @@ use bevy_strands::constraints::Islands;
 use bevy_strands::prelude::*;
 use bevy_strands::world::topology::Topology;
 use bevy_strands_app::fixtures::{
-    check_crossings, crossings, position, strand_particles, velocity,
+    check_crossings, crossings, position, speed_over_fall, strand_particles, velocity,
 };
 
 const TICK: f64 = 1.0 / 60.0;
@@ -240,9 +240,8 @@ fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
         if k >= 120 {
             speed += body_velocity(&app, crate_).length() / 60.0;
         }
-        let fall = (0.3 - body_position(&app, crate_).y).max(1e-3);
         let v = body_velocity(&app, crate_).length();
-        ratio = ratio.max(v / (2.0 * 9.81 * fall).sqrt());
+        ratio = ratio.max(speed_over_fall(v, 0.3, body_position(&app, crate_).y));
     }
     assert!(
         ratio <= 1.01,

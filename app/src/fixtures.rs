@@ -65,6 +65,14 @@ pub fn velocity(app: &App, entity: Entity) -> DVec2 {
     app.world().get::<Velocity>(entity).expect("a particle").0
 }
 
+/// How many times the speed a free fall from height `start` down to `height` allows
+/// (under 9.81 m/s²) a body moving at `speed` goes: above one, something gave it
+/// energy. The fall counts as at least 1 mm, so a body still at its start reads its
+/// speed against that, not a division by zero.
+pub fn speed_over_fall(speed: f64, start: f64, height: f64) -> f64 {
+    speed / (2.0 * 9.81 * (start - height).max(1e-3)).sqrt()
+}
+
 /// The particles of a strand, in order.
 pub fn strand_particles(app: &App, strand: Entity) -> Vec<Entity> {
     app.world()
