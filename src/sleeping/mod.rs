@@ -112,6 +112,18 @@ impl SleepState {
             .is_some_and(|&u| u != NO_UNIT && self.asleep[u as usize])
     }
 
+    /// Whether packed particle `i` has settled: its unit sleeps or has rested `time`
+    /// (a wall's particle, in no unit, always has).
+    pub fn settled(&self, i: usize, time: f64) -> bool {
+        match self.units.of.get(i) {
+            Some(&u) if u != NO_UNIT => {
+                let u = u as usize;
+                self.asleep[u] || self.rested[u] >= time
+            }
+            _ => true,
+        }
+    }
+
     /// Particles in sleeping units.
     pub fn asleep_particles(&self) -> usize {
         (0..self.units.len())
@@ -214,7 +226,7 @@ fn collect_contacts(
 
 /// The end of a tick: each awake unit's rest time, and the mark after which writes are
 /// the user's.
-fn tally(
+pub(crate) fn tally(
     config: Res<StrandsConfig>,
     topology: Res<Topology>,
     state: Res<ParticleState>,

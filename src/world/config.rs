@@ -102,6 +102,11 @@ pub struct SleepConfig {
     /// this, of a unit whose mean speed since its rest began is faster too (or of a
     /// wall), wakes what it will come near. 5 cm/s by default, Box2D's threshold.
     pub speed: f64,
+    /// A rigid body that strands touch or hold is let sleep (by its engine, with the
+    /// strands under it) only once its points move slower than this (world units per
+    /// second) and those strands have rested `time`: an engine's own threshold (avian's
+    /// 15 cm/s) would freeze a crate still rocking on a rope. 1 mm/s by default.
+    pub body_speed: f64,
 }
 
 impl Default for SleepConfig {
@@ -111,6 +116,7 @@ impl Default for SleepConfig {
             drift: 0.02,
             time: 1.0,
             speed: 0.05,
+            body_speed: 1e-3,
         }
     }
 }
@@ -128,6 +134,7 @@ impl SleepConfig {
     pub fn validate(&self) -> Result<(), NumberError> {
         non_negative("drift", self.drift)?;
         non_negative("speed", self.speed)?;
+        non_negative("body_speed", self.body_speed)?;
         non_negative("time", self.time)
     }
 }
@@ -257,6 +264,7 @@ impl StrandsConfig {
             sleep: SleepConfig {
                 drift: default.sleep.drift * unit,
                 speed: default.sleep.speed * unit,
+                body_speed: default.sleep.body_speed * unit,
                 ..default.sleep
             },
             ..default
