@@ -57,6 +57,7 @@ impl Plugin for StrandsAvianPlugin {
             build_outlines,
             (hand_over, push_bodies).chain(),
         );
+        app.register_required_components::<RigidBody, HeldUp>();
         // The strands start from the bodies' new state, whatever schedule drives
         // both (avian's default and the strands' are `FixedPostUpdate`).
         app.configure_sets(
@@ -229,14 +230,50 @@ fn hand_over(
     }
 }
 
-/// The strands' pushes as forces over avian's next step.
-fn push_bodies(mut bodies: Query<(&mut BodyPush, Forces)>) {
-    for (mut push, mut forces) in &mut bodies {
+/// What the strands last held a settled body up with, for the step after they wake
+/// it: asleep, its frame holds still and takes no push, and without this it would
+/// fall for that step before they hold it again.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeldUp {
+    /// The force.
+    pub force: Vec2,
+    /// The torque.
+    pub torque: f32,
+}
+
+/// The strands' pushes as forces over avian's next step: without waking the body when
+/// the strands under it have settled (so avian may put it to sleep), and waking it,
+/// held up as it was, when one that has not touches it asleep.
+fn push_bodies(
+    mut commands: Commands,
+    mut bodies: Query<(Entity, &mut BodyPush, &mut HeldUp, Forces)>,
+) {
+    for (entity, mut push, mut held, mut forces) in &mut bodies {
         if *push == BodyPush::default() {
             continue;
         }
-        let BodyPush { force, torque, .. } = std::mem::take(&mut *push);
-        forces.apply_force(force);
-        forces.apply_torque(torque);
+        let BodyPush {
+            force,
+            torque,
+            settled,
+            wake,
+            ..
+        } = std::mem::take(&mut *push);
+        if wake {
+            // Removing the marker wakes the body's island.
+            commands.entity(entity).try_remove::<Sleeping>();
+            forces.apply_force(held.force);
+            forces.apply_torque(held.torque);
+        } else if settled {
+            if (force, torque) != (Vec2::ZERO, 0.0) {
+                held.set_if_neq(HeldUp { force, torque });
+            }
+            let mut forces = forces.non_waking();
+            forces.apply_force(force);
+            forces.apply_torque(torque);
+        } else {
+            forces.apply_force(force);
+            forces.apply_torque(torque);
+        }
     }
 }

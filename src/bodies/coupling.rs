@@ -81,6 +81,12 @@ impl BodyCoupling {
         self.frames.iter().any(|(f, _)| f.body == body)
     }
 
+    /// Each body with the strands of its own (its outline, frame and the ropes tied
+    /// to it), as (body, strand), this tick, sorted.
+    pub fn own_strands(&self) -> &[(Entity, Entity)] {
+        &self.own
+    }
+
     /// Whether any simulated particle is coupled to a body this tick.
     pub fn couples(&self) -> bool {
         self.coupled.iter().any(|c| c.index != u32::MAX)
@@ -167,6 +173,16 @@ pub(super) fn follow_bodies(
         };
         let offset = rigged.map_or(anchor.offset, |r| r.offset);
         let (point, point_velocity, arm) = body.point_motion(offset);
+        // A body its engine has put to sleep holds still where its particles are (not
+        // moved to the engine's pose: a jump no contact would see), a wall to the
+        // strands until one that has not settled touches it and wakes it (`rest`).
+        if body.is_dynamic() && body.sleeping {
+            velocity.set_if_neq(Velocity(DVec2::ZERO));
+            if !kinematic {
+                commands.entity(entity).insert(Kinematic);
+            }
+            continue;
+        }
         let dynamic = body.is_dynamic();
         let framed = vertex.is_some() || rigged.is_some();
         // A frame the strands handed over last tick carries on from where they left it.
@@ -205,7 +221,10 @@ pub(super) fn follow_bodies(
             // A frame's vertex is never moved there: the frame would jump, and a strand
             // lying against it could end up inside (a crate's corner through the rope
             // bridge it rests on). Driven there through the tick, the contacts see it.
-            let ticks = if touched.iter().any(|(body, _)| *body == anchor.body) {
+            // One still marked kinematic has just woken (or just turned dynamic): its
+            // frame may lie off its engine's pose by what the slow drive left, met
+            // as slowly.
+            let ticks = if kinematic || touched.iter().any(|(body, _)| *body == anchor.body) {
                 TOUCHED_FRAME_TICKS
             } else {
                 1.0

@@ -18,13 +18,14 @@
 //! [`BodySync::Write`]. This module imports no engine.
 //!
 //! Imports: [`crate::model`], [`crate::world`], [`crate::schedule`], [`crate::halving`],
-//! [`crate::colliders`], [`crate::contact_events`].
+//! [`crate::colliders`], [`crate::contact_events`], [`crate::sleeping`].
 
 pub mod anchor;
 mod carry;
 mod coupled;
 pub mod coupling;
 pub mod handoff;
+mod rest;
 pub mod shapes;
 pub mod truss;
 pub mod view;
@@ -123,6 +124,12 @@ impl Plugin for BodyCouplingPlugin {
                     // as the last tick's).
                     coupling::push_bodies
                         .after(TickSet::Writeback)
+                        .before(crate::contact_events::write_messages)
+                        .before(BodySync::Write),
+                    // With this tick's rest times and contacts.
+                    rest::settle_bodies
+                        .after(coupling::push_bodies)
+                        .after(crate::sleeping::tally)
                         .before(crate::contact_events::write_messages)
                         .before(BodySync::Write),
                 ),

@@ -131,6 +131,12 @@ pub struct BodyPush {
     pub force: Vec2,
     /// The torque.
     pub torque: f32,
+    /// Every strand that touches or holds it has settled (rested the sleep time, or
+    /// sleeps): the push must not wake it, so that its engine may put it to sleep.
+    pub settled: bool,
+    /// Its engine has it asleep and a strand that has not settled touches or holds
+    /// it: wake it.
+    pub wake: bool,
 }
 
 /// The state the strands last wrote into a body (the start of the engine's step that

@@ -21,10 +21,11 @@
 use bevy::math::Rot2;
 use bevy::prelude::*;
 
-use bevy_rapier2d::plugin::PhysicsSet;
+use bevy_rapier2d::plugin::context::RapierRigidBodySet;
+use bevy_rapier2d::plugin::{PhysicsSet, RapierContextEntityLink};
 use bevy_rapier2d::prelude::{
     Collider, ExternalForce, LockedAxes, RapierConfiguration, RapierContextSimulation,
-    ReadMassProperties, RigidBody, Sleeping, Velocity,
+    RapierRigidBodyHandle, ReadMassProperties, RigidBody, Sleeping, Velocity,
 };
 
 use crate::bodies::shapes::shape_outline;
@@ -62,7 +63,9 @@ impl Plugin for StrandsRapierPlugin {
         );
         // Rapier writes a body's velocity back only where it has a Velocity, and the
         // strands' force goes through an ExternalForce.
+        // The body's sleep is read and written through this (Rapier adds none).
         app.register_required_components::<RigidBody, Velocity>()
+            .register_required_components::<RigidBody, Sleeping>()
             .register_required_components::<RigidBody, ExternalForce>()
             .register_required_components::<RigidBody, PushedForce>()
             // Rapier stepped in `FixedPostUpdate` goes first too.
@@ -232,19 +235,66 @@ fn hand_over(mut bodies: Query<(&mut BodyPush, &mut Transform, &mut Velocity)>) 
     }
 }
 
+/// What the rapier adapter writes a push into: the body's [`ExternalForce`], its
+/// record of the strands' part of it, its [`Sleeping`], and its handle into Rapier's
+/// set (for a change that must not wake it).
+type PushedBody = (
+    &'static mut BodyPush,
+    &'static mut PushedForce,
+    &'static mut ExternalForce,
+    Option<&'static mut Sleeping>,
+    Option<&'static RapierRigidBodyHandle>,
+    Option<&'static RapierContextEntityLink>,
+);
+
 /// The strands' pushes into each body's [`ExternalForce`] for Rapier's next step, in
-/// place of last tick's (Rapier keeps an external force until it is changed).
-fn push_bodies(mut bodies: Query<(&mut BodyPush, &mut PushedForce, &mut ExternalForce)>) {
-    for (mut push, mut pushed, mut external) in &mut bodies {
+/// place of last tick's (Rapier keeps an external force until it is changed). A
+/// change of the component wakes the body, so while the strands under it have
+/// settled the force goes straight into Rapier's body without waking it (Rapier may
+/// put it to sleep, and wakes it with the force it rests on); one that has not
+/// settled touching it asleep wakes it.
+fn push_bodies(mut bodies: Query<PushedBody>, mut sets: Query<&mut RapierRigidBodySet>) {
+    for (mut push, mut pushed, mut external, sleeping, handle, link) in &mut bodies {
         let new = std::mem::take(&mut *push);
-        if new == BodyPush::default() && *pushed == PushedForce::default() {
+        let asleep = sleeping.as_ref().is_some_and(|s| s.sleeping);
+        if new.wake
+            && let Some(mut sleeping) = sleeping.filter(|_| asleep)
+        {
+            sleeping.sleeping = false;
+        }
+        // Asleep, its frame holds still and takes no push: the force it rests on
+        // stays, for the step it wakes in (this one, when woken now).
+        if asleep {
             continue;
         }
-        external.force += new.force - pushed.force;
-        external.torque += new.torque - pushed.torque;
+        if (new.force, new.torque) == (Vec2::ZERO, 0.0) && *pushed == PushedForce::default() {
+            continue;
+        }
+        let force = external.force + new.force - pushed.force;
+        let torque = external.torque + new.torque - pushed.torque;
         *pushed = PushedForce {
             force: new.force,
             torque: new.torque,
         };
+        let mut set = handle
+            .zip(link)
+            .and_then(|(handle, link)| Some((sets.get_mut(link.0).ok()?, handle.0)));
+        let body = set
+            .as_mut()
+            .and_then(|(set, handle)| set.bodies.get_mut(*handle));
+        match body {
+            Some(body) if new.settled => {
+                // Unseen by Rapier's change detection, which would wake it.
+                let external = external.bypass_change_detection();
+                (external.force, external.torque) = (force, torque);
+                body.reset_forces(false);
+                body.reset_torques(false);
+                body.add_force(force, false);
+                body.add_torque(torque, false);
+            }
+            _ => {
+                (external.force, external.torque) = (force, torque);
+            }
+        }
     }
 }
