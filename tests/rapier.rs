@@ -12,7 +12,8 @@ use bevy_rapier2d::prelude::*;
 use bevy_strands::bodies::BodyCoupling;
 use bevy_strands::prelude::*;
 use bevy_strands_app::fixtures::{
-    check_crossings, crossings, position, speed_over_fall, strand_particles, velocity,
+    EngineBodies, Woken, check_crossings, crossings, position, speed_over_fall, strand_asleep,
+    strand_particles, velocity, wake_a_sleeping_bridge,
 };
 
 const TICK: f64 = 1.0 / 60.0;
@@ -89,6 +90,23 @@ fn in_flight(app: &App) -> DVec2 {
     let coupling = app.world().resource::<bevy_strands::bodies::BodyCoupling>();
     coupling.impulses().map(|(_, _, impulse)| impulse).sum()
 }
+
+/// Rapier's bodies, as the shared bridge test reads and pushes them.
+const ENGINE: EngineBodies = EngineBodies {
+    asleep: |app, body| {
+        app.world()
+            .get::<bevy_rapier2d::prelude::Sleeping>(body)
+            .is_some_and(|s| s.sleeping)
+    },
+    speed: |app, body| body_velocity(app, body).length(),
+    height: |app, body| body_position(app, body).y,
+    shove: |app, body, velocity| {
+        app.world_mut()
+            .get_mut::<bevy_rapier2d::prelude::Velocity>(body)
+            .unwrap()
+            .linear = velocity;
+    },
+};
 
 fn max_error(app: &App) -> f64 {
     app.world().resource::<StrandMetrics>().max_rel_length_error
@@ -327,8 +345,10 @@ fn a_crane_swings_a_crate_on_a_rope() {
 /// The rapier_world example's bridge: posts, ground and five crates dropped one after
 /// another onto the bridge, in `substeps` steps a tick. Returns the crates' mean speed
 /// over each second from 9 s to 15 s; asserts that none falls through or flies off,
-/// every edge stays exact and nothing crosses at any step's end.
-fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
+/// every edge stays exact and nothing crosses at any step's end. Then, all asleep,
+/// they are woken both ways (`wake_a_sleeping_bridge`): what each wake did is
+/// returned too.
+fn crates_on_a_bridge(substeps: u32) -> (Vec<f64>, [Woken; 2]) {
     let mut app = app(Vec2::new(0.0, -9.81));
     app.world_mut().resource_mut::<StrandsConfig>().substeps = substeps;
     let solid = |app: &mut App, centre: Vec2, size: Vec2| {
@@ -350,6 +370,7 @@ fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
         .unwrap();
     let mut crates = Vec::new();
     let mut means = Vec::new();
+    let mut slept = None;
     for k in 0..900 {
         if k % 72 == 71 && crates.len() < 5 {
             let x = [0.62, 0.8, 0.5, 0.95, 0.7][crates.len()];
@@ -368,6 +389,11 @@ fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
             );
         }
         assert_eq!(crossings(&app), 0, "{substeps} steps a tick, tick {k}");
+        let asleep =
+            crates.iter().all(|&c| (ENGINE.asleep)(&app, c)) && strand_asleep(&app, bridge);
+        if crates.len() == 5 && asleep && slept.is_none() {
+            slept = Some(k as f64 * TICK);
+        }
         if k >= 540 {
             if k % 60 == 0 {
                 means.push(0.0);
@@ -388,8 +414,10 @@ fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
         let at = body_position(&app, c);
         assert!(at.y > lowest, "a crate at {at} under the bridge ({lowest})");
     }
+    eprintln!("{substeps} steps a tick: all asleep at {slept:?} s");
+    let woken = wake_a_sleeping_bridge(&mut app, bridge, &crates, &ENGINE);
     assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
-    means
+    (means, woken)
 }
 
 /// Five crates piled on the bridge at 1, 4 and 10 steps a tick: no crossing at any (a
@@ -397,14 +425,27 @@ fn crates_on_a_bridge(substeps: u32) -> Vec<f64> {
 /// bridge at 1 and 4), they lie on it, and they come to rest: every second from 3 s
 /// after the last lands, their mean speed is under 1 mm/s (they rocked at 5–20 mm/s
 /// while a frame the strands touched was driven to its engine's pose in one tick).
+/// Then crates and bridge sleep together, and wake together both ways: a shove to a
+/// crate wakes the bridge, and no crate goes faster than the shove; a strand landing
+/// on the bridge wakes the crates, held up as they slept: none goes faster than 5 cm/s
+/// (measured at most 3 cm/s; woken frames once leapt up at 1 m/s, driven to poses a
+/// slow drive had left them off, and woken crates fell a tick of gravity, 16 cm/s).
 #[test]
 fn crates_dropped_one_after_another_pile_on_a_bridge() {
     for substeps in [1, 4, 10] {
-        let means = crates_on_a_bridge(substeps);
-        eprintln!("{substeps}: {means:?}");
+        let (means, woken) = crates_on_a_bridge(substeps);
+        eprintln!("{substeps}: {means:?} {woken:?}");
         assert!(
             means.iter().all(|m| m.is_finite() && *m < 1e-3),
             "{substeps} steps a tick: the crates' mean speed each second {means:?}"
+        );
+        assert!(
+            woken[0].fastest <= 0.3 * 1.01,
+            "{substeps} steps a tick: after a shove of 0.3 m/s {woken:?}"
+        );
+        assert!(
+            woken[1].fastest <= 0.05,
+            "{substeps} steps a tick: after a landing {woken:?}"
         );
     }
 }

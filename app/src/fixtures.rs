@@ -126,3 +126,111 @@ pub fn run_collide_stage(world: &mut World) {
         .run_system_cached(account_collisions)
         .expect("the account sub-stage runs");
 }
+
+/// How a test reads and pushes the rigid bodies of one engine.
+pub struct EngineBodies {
+    /// Whether the engine has the body asleep.
+    pub asleep: fn(&App, Entity) -> bool,
+    /// Its speed.
+    pub speed: fn(&App, Entity) -> f64,
+    /// The height of its centre.
+    pub height: fn(&App, Entity) -> f64,
+    /// Set its velocity, as a user would.
+    pub shove: fn(&mut App, Entity, Vec2),
+}
+
+/// Whether every free particle of `strand` sleeps.
+pub fn strand_asleep(app: &App, strand: Entity) -> bool {
+    strand_particles(app, strand).iter().all(|&p| {
+        let particle = app.world().entity(p);
+        particle.contains::<Sleeping>() || particle.contains::<Pinned>()
+    })
+}
+
+/// What the crates on a sleeping bridge did when woken, one way: ticks (of 60 a
+/// second) until all slept again, the fastest crate after the wake, and whether the
+/// other side woke.
+#[derive(Clone, Copy, Debug)]
+pub struct Woken {
+    /// Ticks until the crates and the bridge all slept again.
+    pub ticks: usize,
+    /// The fastest crate at any tick after the wake (m/s).
+    pub fastest: f64,
+    /// The side not woken directly (the bridge after a shove, the crates after a
+    /// strand's landing) woke.
+    pub other_woke: bool,
+}
+
+/// Crates at rest on a rope bridge, all asleep (the crates in their engine, the
+/// bridge in the strands), woken both ways in turn: a shove to the first crate
+/// (0.3 m/s, the engine wakes it), then a short strand dropped on the bridge's end
+/// (the strands wake). Asserts that everything sleeps at the start, that nothing
+/// crosses and no crate falls under the bridge at any tick, and that all sleep
+/// again within 15 s of each wake; returns what each wake did.
+pub fn wake_a_sleeping_bridge(
+    app: &mut App,
+    bridge: Entity,
+    crates: &[Entity],
+    engine: &EngineBodies,
+) -> [Woken; 2] {
+    let asleep =
+        |app: &App| crates.iter().all(|&c| (engine.asleep)(app, c)) && strand_asleep(app, bridge);
+    assert!(
+        asleep(app),
+        "asleep at the start: crates {:?}, bridge {}",
+        crates
+            .iter()
+            .map(|&c| (engine.asleep)(app, c))
+            .collect::<Vec<_>>(),
+        strand_asleep(app, bridge)
+    );
+    let mut woken = [Woken {
+        ticks: 0,
+        fastest: 0.0,
+        other_woke: false,
+    }; 2];
+    for (way, woken) in woken.iter_mut().enumerate() {
+        if way == 0 {
+            (engine.shove)(app, crates[0], Vec2::new(0.3, 0.0));
+        } else {
+            StrandBuilder::line(DVec2::new(0.34, 0.9), DVec2::X, 6, 0.01)
+                .mass(0.002)
+                .spawn_in(app.world_mut())
+                .expect("a strand");
+        }
+        let mut slept = false;
+        for k in 1..=900 {
+            app.update();
+            assert_eq!(crossings(app), 0, "way {way}, tick {k}");
+            let lowest = strand_particles(app, bridge)
+                .iter()
+                .map(|&p| position(app, p).y)
+                .fold(f64::INFINITY, f64::min);
+            for &c in crates {
+                let speed = (engine.speed)(app, c);
+                assert!(speed.is_finite(), "way {way}, tick {k}: a crate at {speed}");
+                woken.fastest = woken.fastest.max(speed);
+                let height = (engine.height)(app, c);
+                assert!(
+                    height > lowest,
+                    "way {way}, tick {k}: a crate under the bridge"
+                );
+            }
+            woken.other_woke |= if way == 0 {
+                !strand_asleep(app, bridge)
+            } else {
+                crates.iter().all(|&c| !(engine.asleep)(app, c))
+            };
+            if woken.other_woke && asleep(app) {
+                woken.ticks = k;
+                slept = true;
+                break;
+            }
+        }
+        assert!(
+            slept,
+            "way {way}: not asleep again 15 s after the wake: {woken:?}"
+        );
+    }
+    woken
+}
