@@ -439,14 +439,6 @@ fn crates_dropped_one_after_another_pile_on_a_bridge() {
             means.iter().all(|m| m.is_finite() && *m < 1e-3),
             "{substeps} steps a tick: the crates' mean speed each second {means:?}"
         );
-        assert!(
-            woken[0].fastest <= 0.3 * 1.01,
-            "{substeps} steps a tick: after a shove of 0.3 m/s {woken:?}"
-        );
-        assert!(
-            woken[1].fastest <= 0.05,
-            "{substeps} steps a tick: after a landing {woken:?}"
-        );
     }
 }
 

@@ -165,8 +165,10 @@ pub struct Woken {
 /// bridge in the strands), woken both ways in turn: a shove to the first crate
 /// (0.3 m/s, the engine wakes it), then a short strand dropped on the bridge's end
 /// (the strands wake). Asserts that everything sleeps at the start, that nothing
-/// crosses and no crate falls under the bridge at any tick, and that all sleep
-/// again within 15 s of each wake; returns what each wake did.
+/// crosses and no crate falls under the bridge at any tick, that no crate goes faster
+/// than the shove after it or than 5 cm/s after the landing (a woken crate must be
+/// held up as it slept, not fall a tick of gravity), and that all sleep again within
+/// 15 s of each wake; returns what each wake did.
 pub fn wake_a_sleeping_bridge(
     app: &mut App,
     bridge: Entity,
@@ -190,8 +192,9 @@ pub fn wake_a_sleeping_bridge(
         other_woke: false,
     }; 2];
     for (way, woken) in woken.iter_mut().enumerate() {
+        let shove = 0.3;
         if way == 0 {
-            (engine.shove)(app, crates[0], Vec2::new(0.3, 0.0));
+            (engine.shove)(app, crates[0], Vec2::new(shove as f32, 0.0));
         } else {
             StrandBuilder::line(DVec2::new(0.34, 0.9), DVec2::X, 6, 0.01)
                 .mass(0.002)
@@ -230,6 +233,11 @@ pub fn wake_a_sleeping_bridge(
         assert!(
             slept,
             "way {way}: not asleep again 15 s after the wake: {woken:?}"
+        );
+        let fastest = if way == 0 { shove * 1.01 } else { 0.05 };
+        assert!(
+            woken.fastest <= fastest,
+            "way {way}: a crate went faster than {fastest} m/s: {woken:?}"
         );
     }
     woken
