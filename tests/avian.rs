@@ -217,12 +217,8 @@ fn a_strand_knocks_a_body_and_momentum_is_kept() {
     assert_eq!(crossings(&app), 0);
 }
 
-/// A crate dropped on a sagging rope bridge lands on it and stays on it: it never
-/// passes through, never goes faster than its fall allows (the landing adds no energy),
-/// the bridge's edges stay exact, and at rest the bridge carries it.
-#[test]
-fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
-    let mut app = app(Vec2::new(0.0, -9.81));
+/// A sagging rope bridge pinned at both ends, and a crate 0.3 m over its middle.
+fn crate_over_a_bridge(app: &mut App) -> (Entity, Entity) {
     let points = (0..=30).map(|k| {
         let x = -0.6 + 1.2 * k as f64 / 30.0;
         DVec2::new(x, -0.15 * (1.0 - x * x / 0.36))
@@ -244,6 +240,41 @@ fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
             Transform::from_xyz(0.05, 0.3, 0.0),
         ))
         .id();
+    (bridge, crate_)
+}
+
+/// With the strands' sleeping off nothing they hold has settled, so a crate on a
+/// bridge is pushed awake every tick: avian never puts it to sleep (it would, half a
+/// second under its threshold with no push) and never freezes it over an awake bridge.
+#[test]
+fn with_the_strands_sleeping_off_a_crate_on_them_stays_awake() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let mut config = app.world_mut().resource_mut::<StrandsConfig>();
+    config.sleep.enabled = false;
+    // Slow enough whatever it does (it rocks at about 2 cm/s here): only the strands'
+    // sleeping being off keeps it from settling.
+    config.sleep.body_speed = 1.0;
+    let (_, crate_) = crate_over_a_bridge(&mut app);
+    for k in 0..360 {
+        app.update();
+        let asleep = app
+            .world()
+            .entity(crate_)
+            .contains::<avian2d::prelude::Sleeping>();
+        assert!(!asleep, "tick {k}: the crate sleeps in avian");
+    }
+    // Under avian's threshold (15 cm/s) by then: a crate it would have put to sleep.
+    let speed = body_velocity(&app, crate_).length();
+    assert!(speed < 0.05, "the crate still moves at {speed} m/s");
+}
+
+/// A crate dropped on a sagging rope bridge lands on it and stays on it: it never
+/// passes through, never goes faster than its fall allows (the landing adds no energy),
+/// the bridge's edges stay exact, and at rest the bridge carries it.
+#[test]
+fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let (bridge, crate_) = crate_over_a_bridge(&mut app);
     // Three seconds: it lands, slides to the bridge's lowest part and settles; the
     // last second's mean speed says it rests.
     // Nothing adds energy: at every tick the crate is no faster than its fall from the
