@@ -12,8 +12,8 @@ use bevy_rapier2d::prelude::*;
 use bevy_strands::bodies::BodyCoupling;
 use bevy_strands::prelude::*;
 use bevy_strands_app::fixtures::{
-    EngineBodies, Woken, check_crossings, crossings, position, speed_over_fall, strand_asleep,
-    strand_particles, velocity, wake_a_sleeping_bridge,
+    EngineBodies, Woken, check_crossings, crate_onto_a_sleeping_bridge, crossings, position,
+    speed_over_fall, strand_asleep, strand_particles, velocity, wake_a_sleeping_bridge,
 };
 
 const TICK: f64 = 1.0 / 60.0;
@@ -105,6 +105,11 @@ const ENGINE: EngineBodies = EngineBodies {
             .get_mut::<bevy_rapier2d::prelude::Velocity>(body)
             .unwrap()
             .linear = velocity;
+    },
+    drop_crate: |app, side, density, at| {
+        app.world_mut()
+            .spawn(crate_body(Vec2::splat(side), density, at))
+            .id()
     },
 };
 
@@ -440,6 +445,17 @@ fn crates_dropped_one_after_another_pile_on_a_bridge() {
             "{substeps} steps a tick: the crates' mean speed each second {means:?}"
         );
     }
+}
+
+/// A crate dropped on a rope bridge that sleeps: the bridge wakes as the crate comes,
+/// the crate lands on it without passing through, crossing it or gaining speed, and
+/// both sleep again (the crate in its engine).
+#[test]
+fn a_crate_dropped_on_a_sleeping_bridge_lands_on_it() {
+    let mut app = app(Vec2::new(0.0, -9.81));
+    let seconds = crate_onto_a_sleeping_bridge(&mut app, &ENGINE);
+    eprintln!("asleep again {seconds} s after the drop");
+    assert!(max_error(&app) < 1e-9, "{:e}", max_error(&app));
 }
 
 /// A crate on a light rope, let go at a small angle, swings with the period of the

@@ -137,6 +137,9 @@ pub struct EngineBodies {
     pub height: fn(&App, Entity) -> f64,
     /// Set its velocity, as a user would.
     pub shove: fn(&mut App, Entity, Vec2),
+    /// Spawn a dynamic square crate of this side (m) and density (kg/m²) at a point,
+    /// colliding with strands.
+    pub drop_crate: fn(&mut App, f32, f32, Vec2) -> Entity,
 }
 
 /// Whether every free particle of `strand` sleeps.
@@ -241,4 +244,50 @@ pub fn wake_a_sleeping_bridge(
         );
     }
     woken
+}
+
+/// A rope bridge left to sleep, then a crate dropped 30 cm onto it: its outline's fall
+/// wakes the bridge before they meet (a sleeping strand is a wall to what drives into
+/// it), so the crate lands on the bridge and never goes through it or crosses it, goes
+/// no faster than its fall allows, and then the crate and the bridge sleep together.
+/// Returns the seconds from the drop until both sleep.
+pub fn crate_onto_a_sleeping_bridge(app: &mut App, engine: &EngineBodies) -> f64 {
+    let bridge = StrandBuilder::hanging(DVec2::new(0.3, 0.72), DVec2::new(1.1, 0.72), 40, 1.08)
+        .mass(0.02)
+        .material(StrandMaterial::INERT)
+        .spawn_in(app.world_mut())
+        .expect("a bridge");
+    let mut ticks = 0;
+    while !strand_asleep(app, bridge) {
+        app.update();
+        ticks += 1;
+        assert!(ticks < 600, "the bridge alone did not sleep in 10 s");
+    }
+    let lowest = |app: &App| {
+        strand_particles(app, bridge)
+            .iter()
+            .map(|&p| position(app, p).y)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let start = lowest(app) + 0.35;
+    let crate_ = (engine.drop_crate)(app, 0.1, 40.0, Vec2::new(0.7, start as f32));
+    for k in 1..=900 {
+        app.update();
+        assert_eq!(crossings(app), 0, "tick {k} after the drop");
+        let height = (engine.height)(app, crate_);
+        assert!(
+            height > lowest(app),
+            "tick {k} after the drop: the crate at {height} is under the bridge"
+        );
+        let speed = (engine.speed)(app, crate_);
+        let ratio = speed_over_fall(speed, start, height);
+        assert!(
+            ratio <= 1.01,
+            "tick {k} after the drop: the crate went {ratio} times as fast as its fall allows"
+        );
+        if (engine.asleep)(app, crate_) && strand_asleep(app, bridge) {
+            return k as f64 / 60.0;
+        }
+    }
+    panic!("the crate and the bridge not asleep 15 s after the drop");
 }
