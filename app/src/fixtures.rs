@@ -249,8 +249,8 @@ pub fn wake_a_sleeping_bridge(
 /// A rope bridge left to sleep, then a crate dropped 30 cm onto it: its outline's fall
 /// wakes the bridge before they meet (a sleeping strand is a wall to what drives into
 /// it), so the crate lands on the bridge and never goes through it or crosses it, goes
-/// no faster than its fall allows, and then the crate and the bridge sleep together.
-/// Returns the seconds from the drop until both sleep.
+/// no faster than its fall allows, every edge stays exact, and then the crate and the
+/// bridge sleep together. Returns the seconds from the drop until both sleep.
 pub fn crate_onto_a_sleeping_bridge(app: &mut App, engine: &EngineBodies) -> f64 {
     let bridge = StrandBuilder::hanging(DVec2::new(0.3, 0.72), DVec2::new(1.1, 0.72), 40, 1.08)
         .mass(0.02)
@@ -286,6 +286,8 @@ pub fn crate_onto_a_sleeping_bridge(app: &mut App, engine: &EngineBodies) -> f64
             "tick {k} after the drop: the crate went {ratio} times as fast as its fall allows"
         );
         if (engine.asleep)(app, crate_) && strand_asleep(app, bridge) {
+            let error = app.world().resource::<StrandMetrics>().max_rel_length_error;
+            assert!(error < 1e-9, "the bridge stretched by {error:e}");
             return k as f64 / 60.0;
         }
     }
