@@ -253,21 +253,20 @@ fn push_bodies(
             continue;
         }
         let BodyPush {
-            force,
-            torque,
+            mut force,
+            mut torque,
             settled,
             wake,
             ..
         } = std::mem::take(&mut *push);
         if wake {
-            // Removing the marker wakes the body's island.
+            // Removing the marker wakes the body's island; asleep, it took no push.
             commands.entity(entity).try_remove::<Sleeping>();
-            forces.apply_force(held.force);
-            forces.apply_torque(held.torque);
-        } else if settled {
-            if (force, torque) != (Vec2::ZERO, 0.0) {
-                held.set_if_neq(HeldUp { force, torque });
-            }
+            (force, torque) = (held.force, held.torque);
+        } else if settled && (force, torque) != (Vec2::ZERO, 0.0) {
+            held.set_if_neq(HeldUp { force, torque });
+        }
+        if settled {
             let mut forces = forces.non_waking();
             forces.apply_force(force);
             forces.apply_torque(torque);

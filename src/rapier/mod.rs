@@ -276,25 +276,21 @@ fn push_bodies(mut bodies: Query<PushedBody>, mut sets: Query<&mut RapierRigidBo
             force: new.force,
             torque: new.torque,
         };
-        let mut set = handle
-            .zip(link)
-            .and_then(|(handle, link)| Some((sets.get_mut(link.0).ok()?, handle.0)));
-        let body = set
-            .as_mut()
-            .and_then(|(set, handle)| set.bodies.get_mut(*handle));
-        match body {
-            Some(body) if new.settled => {
-                // Unseen by Rapier's change detection, which would wake it.
-                let external = external.bypass_change_detection();
-                (external.force, external.torque) = (force, torque);
-                body.reset_forces(false);
-                body.reset_torques(false);
-                body.add_force(force, false);
-                body.add_torque(torque, false);
-            }
-            _ => {
-                (external.force, external.torque) = (force, torque);
-            }
+        // Settled, straight into Rapier's body, unseen by the change detection that
+        // would wake it.
+        if new.settled
+            && let Some((handle, link)) = handle.zip(link)
+            && let Ok(mut set) = sets.get_mut(link.0)
+            && let Some(body) = set.bodies.get_mut(handle.0)
+        {
+            body.reset_forces(false);
+            body.reset_torques(false);
+            body.add_force(force, false);
+            body.add_torque(torque, false);
+            let external = external.bypass_change_detection();
+            (external.force, external.torque) = (force, torque);
+        } else {
+            (external.force, external.torque) = (force, torque);
         }
     }
 }
