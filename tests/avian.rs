@@ -14,7 +14,7 @@ use bevy_strands::constraints::Islands;
 use bevy_strands::prelude::*;
 use bevy_strands::world::topology::Topology;
 use bevy_strands_app::fixtures::{
-    EngineBodies, Woken, check_crossings, crate_onto_a_sleeping_bridge, crossings, position,
+    EngineBodies, Woken, check_crossings, crate_onto_a_sleeping_bridge, crossings, lowest_point,
     speed_over_fall, strand_asleep, strand_particles, velocity, wake_a_sleeping_bridge,
 };
 
@@ -305,10 +305,7 @@ fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
         "the crate went {ratio} times as fast as its fall allows"
     );
     let centre = body_position(&app, crate_);
-    let lowest = strand_particles(&app, bridge)
-        .iter()
-        .map(|&p| position(&app, p).y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_point(&app, bridge);
     // On the bridge: above its lowest point by about half the crate, and still.
     assert!(
         centre.y > lowest + 0.09,
@@ -450,10 +447,7 @@ fn crates_on_a_bridge(substeps: u32) -> (Vec<f64>, [Woken; 2]) {
             *means.last_mut().unwrap() += speed / (5.0 * 60.0);
         }
     }
-    let lowest = strand_particles(&app, bridge)
-        .iter()
-        .map(|&p| position(&app, p).y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_point(&app, bridge);
     for &c in &crates {
         let at = body_position(&app, c);
         assert!(at.y > lowest, "a crate at {at} under the bridge ({lowest})");

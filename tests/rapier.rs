@@ -12,8 +12,8 @@ use bevy_rapier2d::prelude::*;
 use bevy_strands::bodies::BodyCoupling;
 use bevy_strands::prelude::*;
 use bevy_strands_app::fixtures::{
-    EngineBodies, Woken, check_crossings, crate_onto_a_sleeping_bridge, crossings, position,
-    speed_over_fall, strand_asleep, strand_particles, velocity, wake_a_sleeping_bridge,
+    EngineBodies, Woken, check_crossings, crate_onto_a_sleeping_bridge, crossings, lowest_point,
+    position, speed_over_fall, strand_asleep, strand_particles, velocity, wake_a_sleeping_bridge,
 };
 
 const TICK: f64 = 1.0 / 60.0;
@@ -261,10 +261,7 @@ fn a_crate_dropped_on_a_rope_bridge_rests_on_it() {
         "the crate went {ratio} times as fast as its fall allows"
     );
     let centre = body_position(&app, crate_);
-    let lowest = strand_particles(&app, bridge)
-        .iter()
-        .map(|&p| position(&app, p).y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_point(&app, bridge);
     assert!(
         centre.y > lowest + 0.09,
         "the crate at {centre} is through the bridge (lowest {lowest})"
@@ -411,10 +408,7 @@ fn crates_on_a_bridge(substeps: u32) -> (Vec<f64>, [Woken; 2]) {
         }
     }
     // Every crate above the bridge's lowest point: on it, not through it.
-    let lowest = strand_particles(&app, bridge)
-        .iter()
-        .map(|&p| position(&app, p).y)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_point(&app, bridge);
     for &c in &crates {
         let at = body_position(&app, c);
         assert!(at.y > lowest, "a crate at {at} under the bridge ({lowest})");

@@ -43,6 +43,14 @@ pub fn set_step(app: &mut App, dt: f64, substeps: u32) {
     config.substeps = substeps;
 }
 
+/// The height of a strand's lowest particle.
+pub fn lowest_point(app: &App, strand: Entity) -> f64 {
+    strand_particles(app, strand)
+        .iter()
+        .map(|&p| position(app, p).y)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Run one tick.
 pub fn tick(app: &mut App) {
     app.world_mut().run_schedule(StrandsTick);
@@ -208,10 +216,7 @@ pub fn wake_a_sleeping_bridge(
         for k in 1..=900 {
             app.update();
             assert_eq!(crossings(app), 0, "way {way}, tick {k}");
-            let lowest = strand_particles(app, bridge)
-                .iter()
-                .map(|&p| position(app, p).y)
-                .fold(f64::INFINITY, f64::min);
+            let lowest = lowest_point(app, bridge);
             for &c in crates {
                 let speed = (engine.speed)(app, c);
                 assert!(speed.is_finite(), "way {way}, tick {k}: a crate at {speed}");
@@ -263,20 +268,14 @@ pub fn crate_onto_a_sleeping_bridge(app: &mut App, engine: &EngineBodies) -> f64
         ticks += 1;
         assert!(ticks < 600, "the bridge alone did not sleep in 10 s");
     }
-    let lowest = |app: &App| {
-        strand_particles(app, bridge)
-            .iter()
-            .map(|&p| position(app, p).y)
-            .fold(f64::INFINITY, f64::min)
-    };
-    let start = lowest(app) + 0.35;
+    let start = lowest_point(app, bridge) + 0.35;
     let crate_ = (engine.drop_crate)(app, 0.1, 40.0, Vec2::new(0.7, start as f32));
     for k in 1..=900 {
         app.update();
         assert_eq!(crossings(app), 0, "tick {k} after the drop");
         let height = (engine.height)(app, crate_);
         assert!(
-            height > lowest(app),
+            height > lowest_point(app, bridge),
             "tick {k} after the drop: the crate at {height} is under the bridge"
         );
         let speed = (engine.speed)(app, crate_);
