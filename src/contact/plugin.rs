@@ -43,8 +43,8 @@ impl Plugin for ContactLoopPlugin {
             .init_resource::<ContactRows>()
             .register_type::<ContactConfig>()
             // The warm starts are the one thing a step leaves for the next.
-            .save_for_halving::<ContactRows, (Vec<(u32, u32, RowImpulse)>, u64)>(
-                |rows, (warm, version)| {
+            .save_for_halving::<ContactRows, (Vec<(u32, u32, RowImpulse)>, u64, f64)>(
+                |rows, (warm, version, warm_dt)| {
                     // The warm starts grow with the keys' buffer: so does their copy.
                     let room = rows.keys.capacity().max(rows.warm.capacity());
                     if warm.capacity() < room {
@@ -52,10 +52,12 @@ impl Plugin for ContactLoopPlugin {
                     }
                     copy_buffer(warm, &rows.warm);
                     *version = rows.warm_version;
+                    *warm_dt = rows.warm_dt;
                 },
-                |rows, (warm, version)| {
+                |rows, (warm, version, warm_dt)| {
                     copy_buffer(&mut rows.warm, warm);
                     rows.warm_version = *version;
+                    rows.warm_dt = *warm_dt;
                 },
             )
             .add_systems(
@@ -119,6 +121,10 @@ pub struct ContactRows {
     warm: Vec<(u32, u32, RowImpulse)>,
     /// The topology version the warm starts belong to.
     warm_version: u64,
+    /// The step the warm starts were taken over: an impulse that held a contact over
+    /// it holds it over a step of another size (a halved or split one) scaled by the
+    /// ratio of the steps — unscaled, a quarter step began with four times the push.
+    warm_dt: f64,
     /// Which rows act, round by round, and the groups they join.
     solve: GroupSolve,
 }
@@ -187,8 +193,9 @@ impl GroupSolve {
 impl ContactRows {
     /// Remember the impulses for the next step's rows of the same pairs, and the
     /// contacts that took one (into `speculated`).
-    fn remember(&mut self, speculated: &mut Vec<Contact>) {
+    fn remember(&mut self, speculated: &mut Vec<Contact>, dt: f64) {
         self.warm.clear();
+        self.warm_dt = dt;
         // As large as the keys' buffer: they grow when it does, not at a later step.
         let room = self.keys.capacity();
         self.warm.reserve(room.saturating_sub(self.warm.len()));
@@ -208,10 +215,23 @@ impl ContactRows {
         self.warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
     }
 
-    fn warm_start(&self, p: u32, key: u32) -> RowImpulse {
-        self.warm
+    /// The warm start of the row keyed `(p, key)` in a step of `dt`.
+    fn warm_start(&self, p: u32, key: u32, dt: f64) -> RowImpulse {
+        let Ok(i) = self
+            .warm
             .binary_search_by_key(&(p, key), |&(q, k, _)| (q, k))
-            .map_or(RowImpulse::default(), |i| self.warm[i].2)
+        else {
+            return RowImpulse::default();
+        };
+        let impulse = self.warm[i].2;
+        if dt == self.warm_dt {
+            return impulse;
+        }
+        let scale = dt / self.warm_dt;
+        RowImpulse {
+            normal: impulse.normal * scale,
+            tangent: impulse.tangent * scale,
+        }
     }
 }
 
@@ -287,7 +307,7 @@ pub fn speculate(
     );
     buffers.impulses.clear();
     for &(p, key, _) in &buffers.keys {
-        let warm = buffers.warm_start(p, key);
+        let warm = buffers.warm_start(p, key, dt);
         buffers.impulses.push(warm);
     }
     if buffers.rows.is_empty() {
@@ -308,7 +328,7 @@ pub fn speculate(
         collider.settings.threads,
         Some(ACTING_MARGIN * thickness),
     );
-    buffers.remember(&mut collider.scratch.speculated);
+    buffers.remember(&mut collider.scratch.speculated, dt);
     for &(island, met) in &buffers.outcomes {
         if !met {
             islands.project_alone(
