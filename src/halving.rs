@@ -15,6 +15,7 @@ use bevy::prelude::*;
 
 use crate::metrics::StrandMetrics;
 use crate::schedule::{StrandsStep, StrandsTick, SyncOnly, TickSet};
+use crate::split_ahead::{SplitAhead, StepWork};
 use crate::world::clock::{SimulationClock, StepTiming};
 use crate::world::config::StrandsConfig;
 use crate::world::state::ParticleState;
@@ -25,7 +26,8 @@ pub struct HalvingPlugin;
 
 impl Plugin for HalvingPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
+        app.init_resource::<StepSplit>()
+            .add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
         // What every step carries forward, for a step taken again in halves.
         app.save_for_halving::<ParticleState, ParticleState>(
             |state, saved| saved.copy_from(state),
@@ -46,10 +48,23 @@ fn run_steps(world: &mut World) {
     }
     let config = world.resource::<StrandsConfig>();
     let (substeps, halvings) = (config.substeps, config.max_step_halvings);
+    let max_level = config.max_split_ahead.min(halvings);
     let start = Instant::now();
     world.schedule_scope(StrandsStep, |world, schedule| {
         for _ in 0..substeps {
-            step(world, schedule, halvings);
+            let ahead = world.get_resource::<StepSplit>().map(|s| s.0);
+            let level = match ahead {
+                Some(ahead) if may_take_again(world, halvings) => ahead.level.min(max_level),
+                _ => 0,
+            };
+            let before = StepWork::of(world.resource::<StrandMetrics>());
+            step(world, schedule, halvings, level);
+            let mut metrics = world.resource_mut::<StrandMetrics>();
+            metrics.split_steps += u64::from(level > 0);
+            let hard = StepWork::of(&metrics).hard_since(&before);
+            if let Some(mut split) = world.get_resource_mut::<StepSplit>() {
+                split.0.after_step(hard, max_level);
+            }
         }
     });
     let seconds = start.elapsed().as_secs_f64();
@@ -58,13 +73,28 @@ fn run_steps(world: &mut World) {
     timing.last_tick_seconds = seconds;
 }
 
-/// Run one step; if it ends in the collision fail-safe and `halvings` allow, put back
+/// Whether a step may be taken again in halves, or in parts ahead: what forbids the
+/// first (an avian body's pose moved between ticks, which a shorter step corrects
+/// faster) forbids the second.
+fn may_take_again(world: &World, halvings: u32) -> bool {
+    halvings > 0 && (world.get_resource::<HalvingSaves>()).is_some_and(|saves| saves.allows(world))
+}
+
+/// How the world's next steps are split ahead (see `split_ahead`).
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct StepSplit(pub SplitAhead);
+
+/// Run one step, as `2^split` parts from the start where `split` and `halvings` allow;
+/// if it (or a part) ends in the collision fail-safe and `halvings` allow, put back
 /// what it changed and take it as two steps of half the size instead (each of which
 /// may be halved again). Whether it ended in the fail-safe after all; such a step
 /// counts once in [`StrandMetrics::failsafe_steps`] however it was cut.
-fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
-    let saving = halvings > 0
-        && (world.get_resource::<HalvingSaves>()).is_some_and(|saves| saves.allows(world));
+fn step(world: &mut World, schedule: &mut Schedule, halvings: u32, split: u32) -> bool {
+    if split > 0 && halvings > 0 {
+        let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
+        return halves(world, schedule, halvings, split - 1, failsafe);
+    }
+    let saving = may_take_again(world, halvings);
     if saving {
         world.resource_scope(|world, mut saves: Mut<HalvingSaves>| saves.save(world));
     }
@@ -77,16 +107,28 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32) -> bool {
     // (A halved step's own save replaces this one: it is no longer needed.)
     world.resource_scope(|world, saves: Mut<HalvingSaves>| saves.restore(world));
     world.resource_mut::<StrandMetrics>().halved_steps += 1;
+    halves(world, schedule, halvings, 0, failsafe)
+}
+
+/// Take the step as two halves, each split `split` more times ahead; `failsafe` is
+/// the count of fail-safe steps before it.
+fn halves(
+    world: &mut World,
+    schedule: &mut Schedule,
+    halvings: u32,
+    split: u32,
+    failsafe: u64,
+) -> bool {
     let dt = world.resource::<StrandsConfig>().dt;
     world.resource_mut::<StrandsConfig>().dt = 0.5 * dt;
     // The clock's time is its steps times the step: counted in halves meanwhile, so
     // that each half ends at its own time, and as one step of `dt` after.
     let steps = world.resource::<SimulationClock>().steps;
     world.resource_mut::<SimulationClock>().steps = 2 * steps;
-    let first = step(world, schedule, halvings - 1);
+    let first = step(world, schedule, halvings - 1, split);
     // Where halving the first half all the way did not spare it the fail-safe, halving
     // is not what this motion needs: the second half is taken whole.
-    let second = step(world, schedule, if first { 0 } else { halvings - 1 });
+    let second = step(world, schedule, if first { 0 } else { halvings - 1 }, split);
     world.resource_mut::<StrandsConfig>().dt = dt;
     let mut clock = world.resource_mut::<SimulationClock>();
     clock.steps = steps + 1;

@@ -61,6 +61,7 @@ pub mod ribbon;
 pub mod schedule;
 pub mod sleeping;
 pub mod snapshot;
+pub mod split_ahead;
 pub mod tearing;
 pub mod transforms;
 pub mod winch;

@@ -168,6 +168,10 @@ pub struct StrandMetrics {
     /// ([`StrandsConfig::max_step_halvings`](crate::world::config::StrandsConfig)).
     #[cfg_attr(feature = "serde", serde(default))]
     pub halved_steps: u64,
+    /// Steps taken in parts from the start because the one before was hard
+    /// ([`StrandsConfig::max_split_ahead`](crate::world::config::StrandsConfig)).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub split_steps: u64,
     /// Steps whose collisions still needed impulses after the last re-projection, so
     /// that edges next to those contacts end the step as the impulses left them.
     pub contact_unsettled_steps: u64,

@@ -126,6 +126,8 @@ pub struct Report {
     pub failsafe_steps: u64,
     /// Steps that would have ended in the fail-safe, taken again as two halves.
     pub halved_steps: u64,
+    /// Steps taken in parts from the start after a hard one.
+    pub split_steps: u64,
     /// Particles asleep at the end of the run.
     pub asleep_particles: usize,
     /// Strands (units of strands joined by shared particles) put to sleep, in all.
@@ -248,6 +250,7 @@ impl Report {
             ("collisions", self.collisions.to_string()),
             ("failsafe_steps", self.failsafe_steps.to_string()),
             ("halved_steps", self.halved_steps.to_string()),
+            ("split_steps", self.split_steps.to_string()),
             (
                 "asleep",
                 format!(

@@ -54,6 +54,8 @@ pub struct RunOptions {
     pub iterations: Option<u32>,
     /// Halvings of a step that would end in the fail-safe, instead of the scene's.
     pub step_halvings: Option<u32>,
+    /// Levels a hard step's successors are split ahead, instead of the scene's.
+    pub split_ahead: Option<u32>,
     /// Keep stretch springs on constrained edges.
     pub stretch_springs: bool,
     /// Never put strands to sleep.
@@ -180,6 +182,9 @@ fn apply_overrides(mut scenario: Scenario, options: &RunOptions) -> Result<Scena
     }
     if let Some(halvings) = options.step_halvings {
         scenario.step.max_step_halvings = halvings;
+    }
+    if let Some(levels) = options.split_ahead {
+        scenario.step.max_split_ahead = levels;
     }
     scenario.constraints.stretch_springs |= options.stretch_springs;
     if options.no_sleep {
@@ -553,6 +558,7 @@ fn report(
         collisions: metrics.collisions,
         failsafe_steps: metrics.failsafe_steps,
         halved_steps: metrics.halved_steps,
+        split_steps: metrics.split_steps,
         asleep_particles: metrics.asleep_particles,
         sleeps: metrics.sleeps,
         wakes: metrics.wakes,

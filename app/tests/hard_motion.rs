@@ -78,38 +78,65 @@ fn a_million_to_one_pendulum_and_a_whip_stay_exact_at_a_game_step() {
     }
 }
 
+/// `long_strand` at 1/60, one step a tick, with the explicit bending it was built with,
+/// for 3 s: its metrics and clock, with `halvings` and `split` ahead.
+fn explicit_long_strand_at_a_games_step(
+    halvings: u32,
+    split: u32,
+) -> (StrandMetrics, SimulationClock) {
+    let mut scenario = load_scenario(&RunOptions {
+        scenario: "long_strand".into(),
+        dt: Some(1.0 / 60.0),
+        substeps: Some(1),
+        check_crossings: true,
+        ..Default::default()
+    })
+    .unwrap();
+    scenario.step.bending = BendingModel::AngleExplicit;
+    let mut app = headless_app(&scenario).unwrap();
+    let mut config = app.world_mut().resource_mut::<StrandsConfig>();
+    config.max_step_halvings = halvings;
+    config.max_split_ahead = split;
+    ticks(&mut app, 180);
+    let clock = *app.world().resource::<SimulationClock>();
+    (app.world().resource::<StrandMetrics>().clone(), clock)
+}
+
 #[test]
 fn a_step_that_would_end_in_the_fail_safe_is_taken_again_in_halves() {
-    // `long_strand` at 1/60, one step a tick, with the explicit bending it was built
-    // with: its landing ends one step in the fail-safe unless that step is taken as two
-    // of 1/120 (measured: 1 halved step, no fail-safe step). With the implicit angle
-    // model it needs neither.
-    let run = |halvings: u32| {
-        let mut scenario = load_scenario(&RunOptions {
-            scenario: "long_strand".into(),
-            dt: Some(1.0 / 60.0),
-            substeps: Some(1),
-            check_crossings: true,
-            ..Default::default()
-        })
-        .unwrap();
-        scenario.step.bending = BendingModel::AngleExplicit;
-        let mut app = headless_app(&scenario).unwrap();
-        app.world_mut()
-            .resource_mut::<StrandsConfig>()
-            .max_step_halvings = halvings;
-        ticks(&mut app, 180);
-        let clock = *app.world().resource::<SimulationClock>();
-        (app.world().resource::<StrandMetrics>().clone(), clock)
-    };
-    let (without, _) = run(0);
+    // Its landing ends one step in the fail-safe unless that step is taken as two of
+    // 1/120 (measured: 1 halved step, no fail-safe step). With the implicit angle model
+    // it needs neither. Splitting ahead off: halving alone.
+    let (without, _) = explicit_long_strand_at_a_games_step(0, 0);
     assert!(without.failsafe_steps > 0, "{without:?}");
     assert_eq!(without.halved_steps, 0);
-    let (with, clock) = run(2);
+    let (with, clock) = explicit_long_strand_at_a_games_step(2, 0);
     assert_eq!(with.failsafe_steps, 0, "{with:?}");
     assert!(with.halved_steps > 0);
+    assert_eq!(with.split_steps, 0);
     assert!(with.max_rel_length_error < 1e-12, "{with:?}");
     assert_eq!(with.edge_crossings, Some(0));
     // The halves add up to the steps they replace.
+    assert!((clock.time - 3.0).abs() < 1e-9, "{clock:?}");
+}
+
+#[test]
+fn steps_after_a_hard_one_are_split_ahead_and_grow_back_whole() {
+    // The same landing with splitting ahead: the steps after the first hard one are
+    // taken in parts from the start, so none needs the fail-safe, and once the strand
+    // lies still they are whole again. The parts add up to the clock's steps.
+    let (metrics, clock) = explicit_long_strand_at_a_games_step(2, 2);
+    eprintln!("{metrics:?}");
+    assert_eq!(metrics.failsafe_steps, 0, "{metrics:?}");
+    assert!(metrics.split_steps > 0, "{metrics:?}");
+    // Split only around the landing, not for the rest of the run.
+    assert!(
+        metrics.split_steps < 90,
+        "{} of 180 split",
+        metrics.split_steps
+    );
+    assert!(metrics.max_rel_length_error < 1e-12, "{metrics:?}");
+    assert_eq!(metrics.edge_crossings, Some(0));
+    assert_eq!(clock.steps, 180);
     assert!((clock.time - 3.0).abs() < 1e-9, "{clock:?}");
 }

@@ -71,6 +71,13 @@ pub struct StrandsConfig {
     /// put back and taken as two steps of half its size, each halved again if it too
     /// would, down to `dt / 2^max_step_halvings`; 0: never.
     pub max_step_halvings: u32,
+    /// A step that follows a hard one (the contact solve left approaches to the
+    /// collision impulses or ran out of Newton steps, or the step was halved) is taken
+    /// in parts from the start, down to `dt / 2^max_split_ahead` (and no finer than
+    /// `max_step_halvings` allows); eight easy steps in a row grow the parts back one
+    /// level. 0: never. Cheaper than halving at a game's step, where a landing makes
+    /// step after step hard (docs/step-size.md).
+    pub max_split_ahead: u32,
     /// When strands at rest go to sleep, and whether they do.
     pub sleep: SleepConfig,
 }
@@ -248,6 +255,7 @@ impl Default for StrandsConfig {
             max_particles: DEFAULT_MAX_PARTICLES,
             max_edges: 2 * DEFAULT_MAX_PARTICLES,
             max_step_halvings: 6,
+            max_split_ahead: DEFAULT_SPLIT_AHEAD,
             sleep: SleepConfig::default(),
         }
     }
@@ -305,10 +313,22 @@ impl StrandsConfig {
                 ),
             });
         }
+        if self.max_split_ahead > MAX_STEP_HALVINGS {
+            return Err(NumberError {
+                field: "max_split_ahead".into(),
+                problem: format!(
+                    "must be at most {MAX_STEP_HALVINGS} (steps of dt / 2^{MAX_STEP_HALVINGS}), got {}",
+                    self.max_split_ahead
+                ),
+            });
+        }
         self.sleep.validate().map_err(|e| e.within("sleep"))?;
         self.material.validate().map_err(|e| e.within("material"))
     }
 }
+
+/// [`StrandsConfig::max_split_ahead`]'s default: a hard step's successors in quarters.
+pub const DEFAULT_SPLIT_AHEAD: u32 = 2;
 
 /// The most halvings [`StrandsConfig::max_step_halvings`] may ask for.
 pub const MAX_STEP_HALVINGS: u32 = 16;

@@ -74,6 +74,11 @@ struct RunArgs {
     /// down to dt / 2^N (default: the scene's, 2; 0: never).
     #[arg(long, value_name = "N")]
     step_halvings: Option<u32>,
+    /// A step that follows a hard one (collision impulses, a capped contact solve, a
+    /// halving) is taken in parts from the start, down to dt / 2^N; eight easy steps
+    /// grow the parts back a level (default: the scene's, 2; 0: never).
+    #[arg(long, value_name = "N")]
+    split_ahead: Option<u32>,
     /// Keep stretch springs on constrained edges too (constraint-drift studies).
     #[arg(long)]
     stretch_springs: bool,
@@ -182,6 +187,7 @@ fn main() -> ExitCode {
                 contact_solver: args.contact_solver,
                 iterations: args.iterations,
                 step_halvings: args.step_halvings,
+                split_ahead: args.split_ahead,
                 stretch_springs: args.stretch_springs,
                 no_sleep: args.no_sleep,
                 start_of_step: args.start_of_step,
