@@ -20,10 +20,16 @@ pub const EASY_STEPS_TO_GROW: u32 = 8;
 /// A step with more collision impulses than one per this many particles is hard.
 pub const PARTICLES_PER_MISS: u64 = 256;
 
+/// A step in which more than one contact projection in this many ran out of Newton
+/// steps is hard.
+pub const SOLVES_PER_CAP: u64 = 8;
+
 /// What makes a step hard, read from the running totals before and after it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepWork {
     collisions: u64,
+    solves: u64,
+    capped: u64,
     failsafe: u64,
     halved: u64,
     particles: u64,
@@ -34,6 +40,8 @@ impl StepWork {
     pub fn of(metrics: &StrandMetrics) -> Self {
         Self {
             collisions: metrics.collisions,
+            solves: metrics.contact_projection.solves,
+            capped: metrics.contact_projection.capped,
             failsafe: metrics.failsafe_steps,
             halved: metrics.halved_steps,
             particles: metrics.particles as u64,
@@ -42,11 +50,14 @@ impl StepWork {
 
     /// Whether the step between `before` and `self` was hard: the contact solve left
     /// approaches to the collision impulses at more than one particle in
-    /// [`PARTICLES_PER_MISS`], or the step needed halving or the fail-safe. (A few
-    /// misses in a large world, or one group's solve running out of Newton steps, are
-    /// cheap to mend; quartering every step of a pile at rest for them is not.)
+    /// [`PARTICLES_PER_MISS`], or more than one of its projections in
+    /// [`SOLVES_PER_CAP`] ran out of Newton steps, or the step needed halving or the
+    /// fail-safe. (A few misses in a large world, or one group in thirty capped now and
+    /// then in a pile at rest, are cheap to mend; quartering every step for them is
+    /// not.)
     pub fn hard_since(&self, before: &Self) -> bool {
         (self.collisions - before.collisions) * PARTICLES_PER_MISS > self.particles
+            || (self.capped - before.capped) * SOLVES_PER_CAP > self.solves - before.solves
             || self.failsafe > before.failsafe
             || self.halved > before.halved
     }
@@ -89,6 +100,26 @@ mod tests {
             particles,
             ..StepWork::default()
         }
+    }
+
+    #[test]
+    fn a_step_is_hard_when_many_of_its_contact_projections_run_out() {
+        let before = StepWork {
+            solves: 100,
+            capped: 10,
+            particles: 3000,
+            ..StepWork::default()
+        };
+        let after = |solves: u64, capped: u64| StepWork {
+            solves: 100 + solves,
+            capped: 10 + capped,
+            ..before
+        };
+        // One group in thirty capped: easy; one in eight or more: hard.
+        assert!(!after(30, 1).hard_since(&before));
+        assert!(!after(16, 2).hard_since(&before));
+        assert!(after(16, 3).hard_since(&before));
+        assert!(after(1, 1).hard_since(&before));
     }
 
     #[test]
