@@ -304,27 +304,24 @@ impl StrandsConfig {
         at_least("substeps", self.substeps as usize, 1, "a tick")?;
         finite_vector("gravity", self.gravity)?;
         non_negative("damping", self.damping)?;
-        if self.max_step_halvings > MAX_STEP_HALVINGS {
-            return Err(NumberError {
-                field: "max_step_halvings".into(),
-                problem: format!(
-                    "must be at most {MAX_STEP_HALVINGS} (steps of dt / 2^{MAX_STEP_HALVINGS}), got {}",
-                    self.max_step_halvings
-                ),
-            });
-        }
-        if self.max_split_ahead > MAX_STEP_HALVINGS {
-            return Err(NumberError {
-                field: "max_split_ahead".into(),
-                problem: format!(
-                    "must be at most {MAX_STEP_HALVINGS} (steps of dt / 2^{MAX_STEP_HALVINGS}), got {}",
-                    self.max_split_ahead
-                ),
-            });
-        }
+        halvings("max_step_halvings", self.max_step_halvings)?;
+        halvings("max_split_ahead", self.max_split_ahead)?;
         self.sleep.validate().map_err(|e| e.within("sleep"))?;
         self.material.validate().map_err(|e| e.within("material"))
     }
+}
+
+/// A count of halvings of the step, at most [`MAX_STEP_HALVINGS`].
+fn halvings(field: &str, value: u32) -> Result<(), NumberError> {
+    if value > MAX_STEP_HALVINGS {
+        return Err(NumberError {
+            field: field.into(),
+            problem: format!(
+                "must be at most {MAX_STEP_HALVINGS} (steps of dt / 2^{MAX_STEP_HALVINGS}), got {value}"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// [`StrandsConfig::max_split_ahead`]'s default: a hard step's successors in quarters.
@@ -584,5 +581,35 @@ impl ContactConfig {
         )?;
         within("keep", self.keep, 0.0..=1.0)?;
         non_negative("reach", self.reach)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halvings_and_splits_past_the_finest_step_are_refused_by_name() {
+        assert!(StrandsConfig::default().validate().is_ok());
+        for (field, set) in [
+            (
+                "max_step_halvings",
+                (|c: &mut StrandsConfig| c.max_step_halvings = 17) as fn(&mut StrandsConfig),
+            ),
+            ("max_split_ahead", |c: &mut StrandsConfig| {
+                c.max_split_ahead = 17
+            }),
+        ] {
+            let mut config = StrandsConfig::default();
+            set(&mut config);
+            let error = config.validate().unwrap_err();
+            assert_eq!(error.field, field);
+            assert!(error.problem.contains("got 17"), "{}", error.problem);
+        }
+        let finest = StrandsConfig {
+            max_split_ahead: MAX_STEP_HALVINGS,
+            ..Default::default()
+        };
+        assert!(finest.validate().is_ok());
     }
 }
