@@ -52,19 +52,20 @@ fn run_steps(world: &mut World) {
     let start = Instant::now();
     world.schedule_scope(StrandsStep, |world, schedule| {
         for _ in 0..substeps {
-            let ahead = world.get_resource::<StepSplit>().map(|s| s.0);
-            let level = match ahead {
-                Some(ahead) if may_take_again(world, halvings) => ahead.level.min(max_level),
-                _ => 0,
+            let level = if may_take_again(world, halvings) {
+                world.resource::<StepSplit>().0.level.min(max_level)
+            } else {
+                0
             };
             let before = StepWork::of(world.resource::<StrandMetrics>());
             step(world, schedule, halvings, level);
             let mut metrics = world.resource_mut::<StrandMetrics>();
             metrics.split_steps += u64::from(level > 0);
             let hard = StepWork::of(&metrics).hard_since(&before);
-            if let Some(mut split) = world.get_resource_mut::<StepSplit>() {
-                split.0.after_step(hard, max_level);
-            }
+            world
+                .resource_mut::<StepSplit>()
+                .0
+                .after_step(hard, max_level);
         }
     });
     let seconds = start.elapsed().as_secs_f64();

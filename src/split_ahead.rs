@@ -56,8 +56,12 @@ impl StepWork {
     /// then in a pile at rest, are cheap to mend; quartering every step for them is
     /// not.)
     pub fn hard_since(&self, before: &Self) -> bool {
-        (self.collisions - before.collisions) * PARTICLES_PER_MISS > self.particles
-            || (self.capped - before.capped) * SOLVES_PER_CAP > self.solves - before.solves
+        // (Saturating: totals a user resets between ticks never count as a hard step.)
+        let collisions = self.collisions.saturating_sub(before.collisions);
+        let capped = self.capped.saturating_sub(before.capped);
+        let solves = self.solves.saturating_sub(before.solves);
+        collisions * PARTICLES_PER_MISS > self.particles
+            || capped * SOLVES_PER_CAP > solves
             || self.failsafe > before.failsafe
             || self.halved > before.halved
     }
