@@ -517,9 +517,10 @@ pub struct ContactConfig {
     /// dependent set of rows asking for absurd corrections is still refused.
     pub max_correction: f64,
     /// Contact rows are met to this many thicknesses per second (a row may end the
-    /// step short of its target by `tolerance × thickness × dt`); the edges are met
-    /// exactly whatever the contacts do. It is the speed at which a resting pile may
-    /// creep into its cushion between steps.
+    /// step short of its target by `tolerance × thickness × dt`, and by no more than
+    /// at a step of 1/300 s at longer steps); the edges are met exactly whatever the
+    /// contacts do. It is the speed at which a resting pile may creep into its
+    /// cushion between steps.
     pub tolerance: f64,
     /// A contact group at rest — its free particles' mean speed, apart from the step's
     /// fall under gravity, below the sleeping speed (`SleepConfig::speed`) — has its
