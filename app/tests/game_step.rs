@@ -232,6 +232,12 @@ fn a_rope_coil_stays_at_rest_at_a_games_step_not_only_at_an_instant() {
     );
     assert_exact("rope_coil", metrics, 8.0 / dt);
     assert!(app.world().resource::<FiniteGuard>().events.is_empty());
-    assert!(20 * fast <= samples, "{fast} of {samples} ticks over 1 cm/s");
-    assert!(20 * moving <= samples, "{moving} of {samples} ticks over 1 mm/s");
+    assert!(
+        20 * fast <= samples,
+        "{fast} of {samples} ticks over 1 cm/s"
+    );
+    assert!(
+        20 * moving <= samples,
+        "{moving} of {samples} ticks over 1 mm/s"
+    );
 }
