@@ -5,12 +5,32 @@
 //! and boils; the angle model takes such strands implicitly. A pile at rest has its
 //! rows met closely by the sweeps, or friction keeps it trembling.
 
+use bevy::prelude::App;
 use bevy_strands::prelude::*;
 use bevy_strands_app::energy::EnergyLedger;
 use bevy_strands_app::fixtures::{check_crossings, ticks};
 use bevy_strands_app::free::FreeSpeeds;
 use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
 use bevy_strands_app::scenario::Scenario;
+
+/// `scenario` at `dt`, one step a tick, sleeping off, its crossings counted.
+fn awake_at(scenario: &mut Scenario, dt: f64) -> App {
+    scenario.step.dt = dt;
+    scenario.step.substeps = 1;
+    scenario.step.sleep.enabled = false;
+    let mut app = headless_app(scenario).unwrap();
+    check_crossings(&mut app);
+    app
+}
+
+/// The built-in scenario `name`.
+fn built_in(name: &str) -> Scenario {
+    load_scenario(&RunOptions {
+        scenario: name.into(),
+        ..Default::default()
+    })
+    .unwrap()
+}
 
 /// Run `scenario` at `dt`, one step a tick, awake, for `seconds`: the speeds at the end,
 /// the metrics and the energy account.
@@ -19,11 +39,7 @@ fn settle(
     dt: f64,
     seconds: f64,
 ) -> ((f64, f64), StrandMetrics, EnergyLedger, Vec<NonFiniteState>) {
-    scenario.step.dt = dt;
-    scenario.step.substeps = 1;
-    scenario.step.sleep.enabled = false;
-    let mut app = headless_app(&scenario).unwrap();
-    check_crossings(&mut app);
+    let mut app = awake_at(&mut scenario, dt);
     let mut ledger = EnergyLedger::default();
     for _ in 0..(seconds / dt).round() as usize {
         ticks(&mut app, 1);
@@ -44,11 +60,7 @@ fn settle(
 /// of its lower layers flicker at 0.1–0.3 m/s for seconds after it lands, whether its
 /// steps are split ahead or not — docs/step-size.md.)
 fn fine_coil() -> Scenario {
-    load_scenario(&RunOptions {
-        scenario: "rope_coil_fine".into(),
-        ..Default::default()
-    })
-    .unwrap()
+    built_in("rope_coil_fine")
 }
 
 /// The built-in `pile_fine` (edges 1.4 thicknesses long), its first 45 strands.
@@ -205,18 +217,9 @@ fn a_rope_coil_stays_at_rest_at_a_games_step_not_only_at_an_instant() {
     // tick from 3 s to 8 s after the drop: with rows met to the whole step's
     // shortfall, particles where two stretches of rope lay wedged flickered at
     // 0.1–0.3 m/s, its 95th percentile over 1 cm/s in 18 % of these ticks and its
-    // median over 1 mm/s in 20 %; met to a 1/300 s step's shortfall, 1 % and none.
-    let mut scenario = load_scenario(&RunOptions {
-        scenario: "rope_coil".into(),
-        ..Default::default()
-    })
-    .unwrap();
+    // median over 1 mm/s in 20 %; met to a 1/300 s step's shortfall, 1 % and 0.3 %.
     let dt = 1.0 / 60.0;
-    scenario.step.dt = dt;
-    scenario.step.substeps = 1;
-    scenario.step.sleep.enabled = false;
-    let mut app = headless_app(&scenario).unwrap();
-    check_crossings(&mut app);
+    let mut app = awake_at(&mut built_in("rope_coil"), dt);
     ticks(&mut app, (3.0 / dt).round() as usize);
     let (mut fast, mut moving, mut samples) = (0, 0, 0);
     for _ in 0..(5.0 / dt).round() as usize {

@@ -4,7 +4,9 @@
 //! the motion a fine step gives.
 
 use bevy_strands::prelude::*;
+use bevy_strands_app::energy::EnergyLedger;
 use bevy_strands_app::fixtures::ticks;
+use bevy_strands_app::free::FreeSpeeds;
 use bevy_strands_app::runner::{RunOptions, headless_app, load_scenario};
 
 /// Run built-in `name` at `dt` (one step a tick) for `seconds`; the times at which the
@@ -79,11 +81,13 @@ fn a_million_to_one_pendulum_and_a_whip_stay_exact_at_a_game_step() {
 }
 
 /// `long_strand` at 1/60, one step a tick, with the explicit bending it was built with,
-/// for 3 s: its metrics and clock, with `halvings` and `split` ahead.
+/// for 3 s, with `halvings` and `split` ahead: its metrics, its clock, the most its
+/// energy rose above its lowest so far, and its free particles' fastest speed at the
+/// end.
 fn explicit_long_strand_at_a_games_step(
     halvings: u32,
     split: u32,
-) -> (StrandMetrics, SimulationClock) {
+) -> (StrandMetrics, SimulationClock, f64, f64) {
     let mut scenario = load_scenario(&RunOptions {
         scenario: "long_strand".into(),
         dt: Some(1.0 / 60.0),
@@ -101,9 +105,16 @@ fn explicit_long_strand_at_a_games_step(
     let mut config = app.world_mut().resource_mut::<StrandsConfig>();
     config.max_step_halvings = halvings;
     config.max_split_ahead = split;
-    ticks(&mut app, 180);
-    let clock = *app.world().resource::<SimulationClock>();
-    (app.world().resource::<StrandMetrics>().clone(), clock)
+    let mut ledger = EnergyLedger::default();
+    for _ in 0..180 {
+        ticks(&mut app, 1);
+        ledger.observe(app.world());
+    }
+    let world = app.world();
+    let clock = *world.resource::<SimulationClock>();
+    let fastest = FreeSpeeds::of(world).quantile(1.0);
+    let metrics = world.resource::<StrandMetrics>().clone();
+    (metrics, clock, ledger.largest_rise, fastest)
 }
 
 #[test]
@@ -111,10 +122,10 @@ fn a_step_that_would_end_in_the_fail_safe_is_taken_again_in_halves() {
     // Its landing ends one step in the fail-safe unless that step is taken as two of
     // 1/120 (measured: 1 halved step, no fail-safe step). With the implicit angle model
     // it needs neither. Splitting ahead off: halving alone.
-    let (without, _) = explicit_long_strand_at_a_games_step(0, 0);
+    let (without, ..) = explicit_long_strand_at_a_games_step(0, 0);
     assert!(without.failsafe_steps > 0, "{without:?}");
     assert_eq!(without.halved_steps, 0);
-    let (with, clock) = explicit_long_strand_at_a_games_step(2, 0);
+    let (with, clock, ..) = explicit_long_strand_at_a_games_step(2, 0);
     assert_eq!(with.failsafe_steps, 0, "{with:?}");
     assert!(with.halved_steps > 0);
     assert_eq!(with.split_steps, 0);
@@ -129,8 +140,12 @@ fn steps_after_a_hard_one_are_split_ahead_and_grow_back_whole() {
     // The same landing with splitting ahead: the steps after the first hard one are
     // taken in parts from the start, so none needs the fail-safe, and once the strand
     // lies still they are whole again. The parts add up to the clock's steps.
-    let (metrics, clock) = explicit_long_strand_at_a_games_step(2, 2);
-    eprintln!("{metrics:?}");
+    let (metrics, clock, rise, fastest) = explicit_long_strand_at_a_games_step(2, 2);
+    let (_, _, halved_rise, halved_fastest) = explicit_long_strand_at_a_games_step(2, 0);
+    eprintln!(
+        "{metrics:?}\nenergy rise {rise} J, fastest at the end {fastest} m/s (halving \
+         alone: {halved_rise} J, {halved_fastest} m/s)"
+    );
     assert_eq!(metrics.failsafe_steps, 0, "{metrics:?}");
     assert!(metrics.split_steps > 0, "{metrics:?}");
     // Split only around the landing, not for the rest of the run.
@@ -143,4 +158,8 @@ fn steps_after_a_hard_one_are_split_ahead_and_grow_back_whole() {
     assert_eq!(metrics.edge_crossings, Some(0));
     assert_eq!(clock.steps, 180);
     assert!((clock.time - 3.0).abs() < 1e-9, "{clock:?}");
+    // The parts put in no energy the halved steps did not, and the strand ends at rest
+    // (asleep, as by default).
+    assert!(rise <= halved_rise, "{rise} J against {halved_rise} J");
+    assert!(fastest < 1e-2, "{fastest} m/s");
 }
