@@ -6,6 +6,7 @@
 use bevy::math::DVec2;
 
 use super::broad_phase::{BroadPhase, BroadPhaseMethod};
+use super::exempt::Exempt;
 use crate::model::Edge;
 use crate::model::geometry::closest_on_segment;
 
@@ -21,7 +22,8 @@ pub struct Overlap {
 }
 
 /// Every point–edge pair closer than `thickness`, in point order, leaving out the
-/// point's own edges and the pairs of three pinned particles (which nothing pushes
+/// point's own edges, the edges of its strand within a thickness of it along the
+/// strand ([`Exempt`]) and the pairs of three pinned particles (which nothing pushes
 /// apart), exactly the pairs the collision stage would consider.
 pub fn overlaps(
     edges: &[Edge],
@@ -34,10 +36,12 @@ pub fn overlaps(
 ) -> Vec<Overlap> {
     broad.build(edges, position, None, thickness, threads);
     let still = vec![DVec2::ZERO; position.len()];
+    let mut exempt = Exempt::default();
+    exempt.build(edges, position.len(), thickness);
     let keep = |p: u32, k: u32| {
         let e = &edges[k as usize];
         let w = |i: u32| inverse_mass[i as usize];
-        e.a != p && e.b != p && (w(p) > 0.0 || w(e.a) > 0.0 || w(e.b) > 0.0)
+        e.a != p && e.b != p && (w(p) > 0.0 || w(e.a) > 0.0 || w(e.b) > 0.0) && !exempt.exempt(p, e)
     };
     let mut pairs = Vec::new();
     broad.point_edge_pairs(method, threads, position, &still, keep, &mut pairs);

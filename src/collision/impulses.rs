@@ -12,6 +12,7 @@ use bevy::platform::collections::HashMap;
 
 use super::broad_phase::{BroadPhase, BroadPhaseMethod};
 use super::ccd::point_edge_time_of_impact;
+use super::exempt::Exempt;
 use super::failsafe::ImpactZones;
 use super::response::{collision_normal_change, contact_change, repulsion_normal_change};
 use super::still::{StillScratch, merge_by_point};
@@ -61,6 +62,11 @@ pub struct ImpulseScratch {
     still: StillScratch,
     /// Candidate (point, edge) pairs of the latest broad phase.
     pub pairs: Vec<(u32, u32)>,
+    /// The pairs of a strand's own points and edges within a thickness along it: they
+    /// are tested for crossing, not kept a cushion apart.
+    exempt: Exempt,
+    /// `pairs` less the exempt ones, when some are.
+    cushioned: Vec<(u32, u32)>,
     displacement: Vec<DVec2>,
     /// Every contact met this step, one per point and edge.
     pub contacts: Vec<Contact>,
@@ -121,6 +127,19 @@ impl ImpulseScratch {
         } else {
             self.contacts[slot as usize] = contact;
         }
+    }
+
+    /// The candidate pairs kept a thickness apart: the latest pairs less the exempt ones
+    /// (all of them when none is).
+    pub fn cushioned_pairs(&mut self, edges: &[Edge]) -> &[(u32, u32)] {
+        if self.exempt.is_empty() {
+            return &self.pairs;
+        }
+        let exempt = &self.exempt;
+        self.cushioned.clear();
+        self.cushioned
+            .extend((self.pairs.iter()).filter(|&&(p, k)| !exempt.exempt(p, &edges[k as usize])));
+        &self.cushioned
     }
 
     /// Whether point `p` met edge `edge` this step.
@@ -206,6 +225,9 @@ impl Collider<'_> {
             self.settings.threads,
         );
         scratch.pairs.clear();
+        scratch
+            .exempt
+            .build(self.edges, self.position.len(), self.settings.thickness);
         let (edges, w, solid) = (self.edges, self.inverse_mass, self.solid);
         let keep = |p: u32, k: u32| {
             let e = &edges[k as usize];
@@ -342,6 +364,9 @@ impl Collider<'_> {
         for slot in 0..self.scratch.pairs.len() {
             let (p, k) = self.scratch.pairs[slot];
             let e = &self.edges[k as usize];
+            if self.scratch.exempt.exempt(p, e) {
+                continue;
+            }
             let (x, q, r) = (
                 self.position[p as usize],
                 self.position[e.a as usize],

@@ -25,6 +25,7 @@ pub mod broad_phase;
 pub mod ccd;
 pub mod clearance;
 pub mod crossings;
+pub mod exempt;
 pub mod failsafe;
 pub mod impulses;
 pub mod plugin;

@@ -297,7 +297,7 @@ pub fn speculate(
     collider.scratch.speculated_step = true;
     let dt = collider.dt;
     speculative_rows(
-        &collider.scratch.pairs,
+        collider.scratch.cushioned_pairs(collider.edges),
         collider.edges,
         collider.position,
         collider.velocity,
