@@ -14,13 +14,18 @@ use bevy::ecs::entity::EntityHashMap;
 use bevy::math::DVec2;
 use bevy::prelude::*;
 
+use crate::contact::plugin::ContactRows;
+use crate::contact::rows::RowImpulse;
+use crate::contact::warm::{NamedWarmStart, Partner};
 use crate::schedule::synchronise;
 use crate::world::clock::SimulationClock;
 use crate::world::hooks::SpawnOrder;
 use crate::world::particle::{
     ExternalForce, Kinematic, Mass, Particle, Pinned, Position, Sleeping, Velocity,
 };
+use crate::world::state::ParticleState;
 use crate::world::strand::{Strand, StrandKind, StrandMaterial, StrandOf};
+use crate::world::topology::Topology;
 
 /// The snapshot format written by [`StrandsSnapshot::capture`].
 pub const SNAPSHOT_VERSION: u32 = 1;
@@ -75,6 +80,25 @@ pub struct StrandRecord {
     pub material: Option<StrandMaterial>,
 }
 
+/// A contact's warm start as captured: the impulse its row held at the last step,
+/// which the next step starts from.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ContactRecord {
+    /// The point (its number in the snapshot).
+    pub point: u32,
+    /// The strand it meets, if it meets that strand's nearest edge.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub strand: Option<u32>,
+    /// The edge it meets, by its particles' numbers, if it meets a corner's second edge.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub edge: Option<[u32; 2]>,
+    /// The impulse along the normal.
+    pub normal: f64,
+    /// The impulse along the tangent.
+    pub tangent: f64,
+}
+
 /// The simulated state of a world.
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -90,6 +114,13 @@ pub struct StrandsSnapshot {
     pub particles: Vec<ParticleRecord>,
     /// Every strand, in entity order.
     pub strands: Vec<StrandRecord>,
+    /// The contacts' warm starts (absent in snapshots written before 2026-12-07: the
+    /// continued run's first step then starts its contacts cold).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub contacts: Vec<ContactRecord>,
+    /// The step the warm starts were taken over.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub contact_step: f64,
 }
 
 /// Which entity each number of a snapshot stands for.
@@ -150,6 +181,15 @@ pub enum SnapshotError {
     /// not keep the captured order.
     #[error("the world already holds {0} particles or strands; restore into an empty one")]
     NotEmpty(usize),
+    /// A contact's warm start names a particle or strand the snapshot does not have,
+    /// or not exactly one partner.
+    #[error(
+        "contact {contact} names a particle or strand the snapshot does not have, or not exactly one of a strand and an edge"
+    )]
+    BadContact {
+        /// The contact (its index).
+        contact: usize,
+    },
 }
 
 impl StrandsSnapshot {
@@ -214,11 +254,14 @@ impl StrandsSnapshot {
                 }
             })
             .collect();
+        let (contacts, contact_step) = capture_contacts(world, &entities);
         let snapshot = StrandsSnapshot {
             version: SNAPSHOT_VERSION,
             clock: *world.resource::<SimulationClock>(),
             particles,
             strands,
+            contacts,
+            contact_step,
         };
         (snapshot, entities)
     }
@@ -236,6 +279,23 @@ impl StrandsSnapshot {
                     particle,
                     count: self.particles.len(),
                 });
+            }
+        }
+        for (contact, record) in self.contacts.iter().enumerate() {
+            let particles = [record.point]
+                .into_iter()
+                .chain(record.edge.into_iter().flatten());
+            let strand_ok = record
+                .strand
+                .is_none_or(|s| (s as usize) < self.strands.len());
+            let one_partner = record.strand.is_some() != record.edge.is_some();
+            if !strand_ok
+                || !one_partner
+                || particles
+                    .into_iter()
+                    .any(|p| p as usize >= self.particles.len())
+            {
+                return Err(SnapshotError::BadContact { contact });
             }
         }
         for (particle, record) in self.particles.iter().enumerate() {
@@ -315,6 +375,7 @@ impl StrandsSnapshot {
         // state as the last tick left them: build them now, as that tick would have.
         synchronise(world);
         let restored = SnapshotEntities { particles, strands };
+        self.restore_contacts(world, &restored);
         let in_order = match world.get_resource::<SpawnOrder>() {
             Some(order) => {
                 restored
@@ -332,4 +393,72 @@ impl StrandsSnapshot {
         }
         Ok(restored)
     }
+}
+
+impl StrandsSnapshot {
+    /// Give the restored world's contact rows the captured warm starts.
+    fn restore_contacts(&self, world: &mut World, restored: &SnapshotEntities) {
+        if self.contacts.is_empty() || !world.contains_resource::<ContactRows>() {
+            return;
+        }
+        let particle = |p: u32| restored.particles.get(p as usize).copied();
+        let named: Vec<NamedWarmStart> = (self.contacts.iter())
+            .filter_map(|c| {
+                let partner = match (c.strand, c.edge) {
+                    (Some(s), None) => Partner::Strand(*restored.strands.get(s as usize)?),
+                    (None, Some([a, b])) => Partner::Edge(particle(a)?, particle(b)?),
+                    _ => return None, // refused by `check`
+                };
+                Some(NamedWarmStart {
+                    point: particle(c.point)?,
+                    partner,
+                    impulse: RowImpulse {
+                        normal: c.normal,
+                        tangent: c.tangent,
+                    },
+                })
+            })
+            .collect();
+        world.resource_scope(|world, mut rows: Mut<ContactRows>| {
+            let entities = &world.resource::<ParticleState>().entity;
+            rows.restore_warm_starts(
+                &named,
+                self.contact_step,
+                entities,
+                world.resource::<Topology>(),
+            );
+        });
+    }
+}
+
+/// The contact rows' warm starts of `world`, numbered as `entities` numbers the
+/// snapshot, and the step they were taken over.
+fn capture_contacts(world: &World, entities: &SnapshotEntities) -> (Vec<ContactRecord>, f64) {
+    let Some(rows) = world.get_resource::<ContactRows>() else {
+        return (Vec::new(), 0.0);
+    };
+    let (named, step) = rows.named_warm_starts();
+    let numbers = |list: &[Entity]| -> EntityHashMap<u32> {
+        (list.iter().enumerate())
+            .map(|(i, &e)| (e, i as u32))
+            .collect()
+    };
+    let (particles, strands) = (numbers(&entities.particles), numbers(&entities.strands));
+    let particle = |e: Entity| particles.get(&e).copied();
+    let records = (named.iter())
+        .filter_map(|w| {
+            let (strand, edge) = match w.partner {
+                Partner::Strand(s) => (Some(*strands.get(&s)?), None),
+                Partner::Edge(a, b) => (None, Some([particle(a)?, particle(b)?])),
+            };
+            Some(ContactRecord {
+                point: particle(w.point)?,
+                strand,
+                edge,
+                normal: w.impulse.normal,
+                tangent: w.impulse.tangent,
+            })
+        })
+        .collect();
+    (records, step)
 }

@@ -399,3 +399,52 @@ fn a_restored_world_is_synchronised_before_its_first_tick() {
     let positions = |app: &App| app.world().resource::<ParticleState>().position.clone();
     assert_eq!(positions(&restored), positions(&app));
 }
+
+#[test]
+fn a_restored_world_keeps_its_contacts_warm() {
+    // Strands lying on the floor and on each other: the next step starts every
+    // contact from the impulse it held. A snapshot carries those impulses, by entity,
+    // so the restored run goes on bit for bit (before, it started its contacts cold
+    // and parted from the first step). Sleeping off: asleep, they would hold no rows.
+    let awake = || {
+        let mut app = app();
+        app.world_mut()
+            .resource_mut::<StrandsConfig>()
+            .sleep
+            .enabled = false;
+        app
+    };
+    let mut app = awake();
+    spawn_box(&mut app);
+    for (k, y) in [0.006, 0.012].into_iter().enumerate() {
+        StrandBuilder::line(DVec2::new(0.2 + 0.01 * k as f64, y), DVec2::X, 12, 0.03)
+            .spawn_in(app.world_mut())
+            .unwrap();
+    }
+    ticks(&mut app, 150);
+    let (snapshot, _) = StrandsSnapshot::capture(app.world_mut());
+    assert!(snapshot.contacts.len() >= 12, "{}", snapshot.contacts.len());
+
+    let mut restored = awake();
+    snapshot.restore(restored.world_mut()).unwrap();
+    for other in [&mut app, &mut restored] {
+        ticks(other, 60);
+    }
+    let state = |app: &App| {
+        let state = app.world().resource::<ParticleState>();
+        (state.position.clone(), state.velocity.clone())
+    };
+    assert!(state(&restored) == state(&app), "the restored run parted");
+
+    // A warm start naming a particle the snapshot lacks is refused, nothing spawned.
+    let mut broken = snapshot.clone();
+    broken.contacts[0].point = broken.particles.len() as u32;
+    let mut world = awake();
+    assert!(broken.restore(world.world_mut()).is_err());
+    let particles = world
+        .world_mut()
+        .query_filtered::<(), With<Particle>>()
+        .iter(world.world())
+        .count();
+    assert_eq!(particles, 0);
+}

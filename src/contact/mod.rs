@@ -36,6 +36,7 @@ pub mod settings;
 pub mod speculative;
 pub mod split;
 pub mod sweeps;
+pub mod warm;
 
 pub use plugin::{ContactLoopPlugin, ContactRows};
 pub use projection::project_with_contacts;

@@ -20,6 +20,7 @@ use super::driver::GroupDriver;
 use super::rows::{ContactRow, RowImpulse};
 use super::settings::{ContactOutcome, ContactSettings, Resting};
 use super::speculative::{SpeculationScratch, SpeculationSettings, speculative_rows};
+use super::warm::{NamedWarmStart, NewIndices, Numbering, keyed, named, renumber};
 use crate::collision::CollisionScratch;
 use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
@@ -130,6 +131,9 @@ pub struct ContactRows {
     warm: Vec<(u32, u32, RowImpulse)>,
     /// The topology version the warm starts belong to.
     warm_version: u64,
+    /// What the packed indices of topology version `numbering.1` stand for: warm
+    /// starts of that version are renamed through it when the topology is rebuilt.
+    numbering: (Numbering, Option<u64>),
     /// The step the warm starts were taken over: an impulse that held a contact over
     /// it holds it over a step of another size (a halved or split one) scaled by the
     /// ratio of the steps — unscaled, a quarter step began with four times the push.
@@ -224,6 +228,62 @@ impl ContactRows {
         self.warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
     }
 
+    /// Carry the warm starts over to `topology`'s numbering (`particles`: its packed
+    /// particles' entities), dropping those of contacts it no longer has.
+    fn renumber(&mut self, particles: &[Entity], topology: &Topology) {
+        let strands: Vec<Entity> = topology.strands.iter().map(|s| s.entity).collect();
+        let (numbering, version) = &mut self.numbering;
+        // Warm starts restored by a halving from before the last renaming are of a
+        // numbering no longer kept: they are dropped, as every one was before.
+        if *version == Some(self.warm_version) {
+            let new = NewIndices {
+                particles: &topology.index,
+                strands: &strands,
+                edges: &topology.edges,
+            };
+            renumber(&mut self.warm, numbering, &new);
+        } else {
+            self.warm.clear();
+        }
+        numbering.record(particles, &strands, &topology.edges);
+        *version = Some(topology.version);
+        self.warm_version = topology.version;
+    }
+
+    /// The warm starts the next step will use, named by entity, and the step they were
+    /// taken over (for a snapshot).
+    pub fn named_warm_starts(&self) -> (Vec<NamedWarmStart>, f64) {
+        let (numbering, version) = &self.numbering;
+        if *version != Some(self.warm_version) {
+            return (Vec::new(), self.warm_dt);
+        }
+        (named(&self.warm, numbering), self.warm_dt)
+    }
+
+    /// Take `warm` (taken over a step of `dt`) as the warm starts of `topology`, whose
+    /// packed particles are `particles` (a restored snapshot's).
+    pub fn restore_warm_starts(
+        &mut self,
+        warm: &[NamedWarmStart],
+        dt: f64,
+        particles: &[Entity],
+        topology: &Topology,
+    ) {
+        let strands: Vec<Entity> = topology.strands.iter().map(|s| s.entity).collect();
+        let new = NewIndices {
+            particles: &topology.index,
+            strands: &strands,
+            edges: &topology.edges,
+        };
+        self.warm = keyed(warm, &new);
+        self.warm_dt = dt;
+        self.numbering
+            .0
+            .record(particles, &strands, &topology.edges);
+        self.numbering.1 = Some(topology.version);
+        self.warm_version = topology.version;
+    }
+
     /// The warm start of the row keyed `(p, key)` in a step of `dt`.
     fn warm_start(&self, p: u32, key: u32, dt: f64) -> RowImpulse {
         let Ok(i) = self
@@ -281,9 +341,8 @@ pub fn speculate(
     let thickness = collisions.thickness;
     let reach = contact.reach.max(1.0) * thickness;
     let buffers = &mut *buffers;
-    if buffers.warm_version != topology.version {
-        buffers.warm.clear();
-        buffers.warm_version = topology.version;
+    if buffers.warm_version != topology.version || buffers.numbering.1 != Some(topology.version) {
+        buffers.renumber(&state.entity, &topology);
     }
     let mut collider = collider(
         &mut state,
