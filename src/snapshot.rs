@@ -182,9 +182,10 @@ pub enum SnapshotError {
     #[error("the world already holds {0} particles or strands; restore into an empty one")]
     NotEmpty(usize),
     /// A contact's warm start names a particle or strand the snapshot does not have,
-    /// or not exactly one partner.
+    /// or not exactly one partner, or its impulse or step is not a finite number (the
+    /// step not positive).
     #[error(
-        "contact {contact} names a particle or strand the snapshot does not have, or not exactly one of a strand and an edge"
+        "contact {contact} names a particle or strand the snapshot does not have, or not exactly one of a strand and an edge, or its impulse or the contacts' step is not finite"
     )]
     BadContact {
         /// The contact (its index).
@@ -289,8 +290,13 @@ impl StrandsSnapshot {
                 .strand
                 .is_none_or(|s| (s as usize) < self.strands.len());
             let one_partner = record.strand.is_some() != record.edge.is_some();
+            let finite = record.normal.is_finite()
+                && record.tangent.is_finite()
+                && self.contact_step.is_finite()
+                && self.contact_step > 0.0;
             if !strand_ok
                 || !one_partner
+                || !finite
                 || particles
                     .into_iter()
                     .any(|p| p as usize >= self.particles.len())

@@ -447,4 +447,7 @@ fn a_restored_world_keeps_its_contacts_warm() {
         .iter(world.world())
         .count();
     assert_eq!(particles, 0);
+    let mut broken = snapshot.clone();
+    broken.contacts[0].normal = f64::NAN;
+    assert!(broken.restore(awake().world_mut()).is_err());
 }

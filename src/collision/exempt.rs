@@ -35,12 +35,15 @@ pub struct Exempt {
     /// The walk's frontier and the particles it has reached, with their distance.
     stack: Vec<(u32, f64)>,
     reached: Vec<(u32, f64)>,
+    /// The topology version and thickness of the last [`Exempt::update`].
+    built_for: Option<(u64, u64)>,
 }
 
 impl Exempt {
     /// Build from `edges` over `particles` particles for `thickness`. Costs one pass
     /// over the edges when none is within the reach.
     pub fn build(&mut self, edges: &[Edge], particles: usize, thickness: f64) {
+        self.built_for = None;
         self.start.clear();
         self.near.clear();
         let reach = thickness * REACH;
@@ -54,6 +57,16 @@ impl Exempt {
             self.walk(p, reach);
         }
         self.start.push(self.near.len() as u32);
+    }
+
+    /// [`Exempt::build`] unless the last update was for the same topology `version`
+    /// (whose edges `edges` are) and `thickness`.
+    pub fn update(&mut self, version: u64, edges: &[Edge], particles: usize, thickness: f64) {
+        let key = Some((version, thickness.to_bits()));
+        if self.built_for != key {
+            self.build(edges, particles, thickness);
+            self.built_for = key;
+        }
     }
 
     /// Whether no point is exempt from any edge.
@@ -166,6 +179,21 @@ mod tests {
         exempt.build(&edges, 7, t);
         assert!(exempt.exempt(0, &edges[2]) && !exempt.exempt(0, &edges[3]));
         assert!(exempt.exempt(3, &edges[0]) && exempt.exempt(3, &edges[5]));
+    }
+
+    #[test]
+    fn an_update_rebuilds_for_a_new_topology_or_thickness_only() {
+        let (t, short, long) = (0.004, chain(&[0.004; 3]), chain(&[0.01; 3]));
+        let mut exempt = Exempt::default();
+        exempt.update(1, &short, 4, t);
+        assert!(exempt.exempt(0, &short[1]));
+        // The same version: what was built stands.
+        exempt.update(1, &long, 4, t);
+        assert!(exempt.exempt(0, &short[1]));
+        exempt.update(2, &long, 4, t);
+        assert!(exempt.is_empty());
+        exempt.update(2, &long, 4, 0.009);
+        assert!(exempt.exempt(0, &long[1]));
     }
 
     #[test]

@@ -189,6 +189,9 @@ impl CollisionOutcome {
 pub struct Collider<'a> {
     /// Every edge (walls included).
     pub edges: &'a [Edge],
+    /// The topology version the edges are of (what is derived from them is kept
+    /// while it holds).
+    pub version: u64,
     /// Positions at the start of the step.
     pub position: &'a [DVec2],
     /// Velocities: the step's motion, changed by the impulses.
@@ -225,9 +228,12 @@ impl Collider<'_> {
             self.settings.threads,
         );
         scratch.pairs.clear();
-        scratch
-            .exempt
-            .build(self.edges, self.position.len(), self.settings.thickness);
+        scratch.exempt.update(
+            self.version,
+            self.edges,
+            self.position.len(),
+            self.settings.thickness,
+        );
         let (edges, w, solid) = (self.edges, self.inverse_mass, self.solid);
         let keep = |p: u32, k: u32| {
             let e = &edges[k as usize];

@@ -87,6 +87,7 @@ pub fn collider<'a>(
     } = state;
     Collider {
         edges: &topology.edges,
+        version: topology.version,
         position,
         velocity,
         mass,
