@@ -20,7 +20,7 @@ use super::driver::GroupDriver;
 use super::rows::{ContactRow, RowImpulse};
 use super::settings::{ContactOutcome, ContactSettings, Resting};
 use super::speculative::{SpeculationScratch, SpeculationSettings, speculative_rows};
-use super::warm::{NamedWarmStart, NewIndices, Numbering, keyed, named, renumber};
+use super::warm::{NamedWarmStart, NewIndices, Numbering, keyed, named};
 use crate::collision::CollisionScratch;
 use crate::collision::impulses::{Collider, Contact};
 use crate::collision::plugin::collider;
@@ -131,9 +131,9 @@ pub struct ContactRows {
     warm: Vec<(u32, u32, RowImpulse)>,
     /// The topology version the warm starts belong to.
     warm_version: u64,
-    /// What the packed indices of topology version `numbering.1` stand for: warm
-    /// starts of that version are renamed through it when the topology is rebuilt.
-    numbering: (Numbering, Option<u64>),
+    /// What the packed indices of the numbering's version stand for: warm starts of
+    /// that version are renamed through it when the topology is rebuilt.
+    numbering: Numbering,
     /// The step the warm starts were taken over: an impulse that held a contact over
     /// it holds it over a step of another size (a halved or split one) scaled by the
     /// ratio of the steps — unscaled, a quarter step began with four times the push.
@@ -229,35 +229,26 @@ impl ContactRows {
     }
 
     /// Carry the warm starts over to `topology`'s numbering (`particles`: its packed
-    /// particles' entities), dropping those of contacts it no longer has.
+    /// particles' entities), dropping those of contacts it no longer has. Warm starts
+    /// restored by a halving from before the last renaming are of a numbering no
+    /// longer kept: they are dropped, as every one was before.
     fn renumber(&mut self, particles: &[Entity], topology: &Topology) {
-        let strands: Vec<Entity> = topology.strands.iter().map(|s| s.entity).collect();
-        let (numbering, version) = &mut self.numbering;
-        // Warm starts restored by a halving from before the last renaming are of a
-        // numbering no longer kept: they are dropped, as every one was before.
-        if *version == Some(self.warm_version) {
-            let new = NewIndices {
-                particles: &topology.index,
-                strands: &strands,
-                edges: &topology.edges,
-            };
-            renumber(&mut self.warm, numbering, &new);
-        } else {
-            self.warm.clear();
-        }
-        numbering.record(particles, &strands, &topology.edges);
-        *version = Some(topology.version);
-        self.warm_version = topology.version;
+        let (warm, dt) = self.named_warm_starts();
+        self.restore_warm_starts(&warm, dt, particles, topology);
+    }
+
+    /// Whether the warm starts are numbered as topology `version` is.
+    fn numbered_for(&self, version: u64) -> bool {
+        self.warm_version == version && self.numbering.version == Some(version)
     }
 
     /// The warm starts the next step will use, named by entity, and the step they were
     /// taken over (for a snapshot).
     pub fn named_warm_starts(&self) -> (Vec<NamedWarmStart>, f64) {
-        let (numbering, version) = &self.numbering;
-        if *version != Some(self.warm_version) {
+        if !self.numbered_for(self.warm_version) {
             return (Vec::new(), self.warm_dt);
         }
-        (named(&self.warm, numbering), self.warm_dt)
+        (named(&self.warm, &self.numbering), self.warm_dt)
     }
 
     /// Take `warm` (taken over a step of `dt`) as the warm starts of `topology`, whose
@@ -277,10 +268,7 @@ impl ContactRows {
         };
         self.warm = keyed(warm, &new);
         self.warm_dt = dt;
-        self.numbering
-            .0
-            .record(particles, &strands, &topology.edges);
-        self.numbering.1 = Some(topology.version);
+        (self.numbering).record(topology.version, particles, &strands, &topology.edges);
         self.warm_version = topology.version;
     }
 
@@ -341,7 +329,7 @@ pub fn speculate(
     let thickness = collisions.thickness;
     let reach = contact.reach.max(1.0) * thickness;
     let buffers = &mut *buffers;
-    if buffers.warm_version != topology.version || buffers.numbering.1 != Some(topology.version) {
+    if !buffers.numbered_for(topology.version) {
         buffers.renumber(&state.entity, &topology);
     }
     let mut collider = collider(

@@ -9,7 +9,8 @@
 //! let the awake pile above it sag, and once the sleeping stopped the rows pushed the
 //! sagged pile back out of the cushion and threw it upward (the built-in `pile_fine`
 //! at 1/300 s gained 410 J that way). So the keys are renamed through the entities
-//! they stand for, and only the rows whose point, strand or edge is gone lose theirs.
+//! they stand for ([`named`] under the old numbering, [`keyed`] under the new), and
+//! only the rows whose point, strand or edge is gone lose theirs.
 
 use bevy::ecs::entity::{Entity, EntityHashMap};
 use bevy::platform::collections::HashMap;
@@ -21,6 +22,8 @@ use crate::model::Edge;
 /// What the packed indices of one topology stand for.
 #[derive(Clone, Debug, Default)]
 pub struct Numbering {
+    /// The topology version recorded (none yet).
+    pub version: Option<u64>,
     /// Each packed particle's entity.
     pub particles: Vec<Entity>,
     /// Each strand's entity.
@@ -30,8 +33,15 @@ pub struct Numbering {
 }
 
 impl Numbering {
-    /// Record the numbering of `particles`, `strands` and `edges`.
-    pub fn record(&mut self, particles: &[Entity], strands: &[Entity], edges: &[Edge]) {
+    /// Record the numbering of topology `version`: `particles`, `strands` and `edges`.
+    pub fn record(
+        &mut self,
+        version: u64,
+        particles: &[Entity],
+        strands: &[Entity],
+        edges: &[Edge],
+    ) {
+        self.version = Some(version);
         self.particles.clear();
         self.particles.extend_from_slice(particles);
         self.strands.clear();
@@ -49,47 +59,6 @@ pub struct NewIndices<'a> {
     pub strands: &'a [Entity],
     /// Every edge.
     pub edges: &'a [Edge],
-}
-
-/// Rename the keys of `warm` (point, strand or [`EDGE_KEY`] | edge, impulse) from the
-/// numbering `old` to `new`, dropping those whose point, strand or edge is gone, and
-/// sort them by key again.
-pub fn renumber(warm: &mut Vec<(u32, u32, RowImpulse)>, old: &Numbering, new: &NewIndices) {
-    let strand_of: HashMap<Entity, u32> = (new.strands.iter().enumerate())
-        .map(|(i, &e)| (e, i as u32))
-        .collect();
-    let corners = warm.iter().any(|&(_, key, _)| key & EDGE_KEY != 0);
-    let edge_of: HashMap<(u32, u32), u32> = if corners {
-        (new.edges.iter().enumerate())
-            .map(|(k, e)| ((e.a, e.b), k as u32))
-            .collect()
-    } else {
-        HashMap::default()
-    };
-    let particle = |i: u32| -> Option<u32> {
-        let entity = old.particles.get(i as usize)?;
-        new.particles.get(entity).copied()
-    };
-    warm.retain_mut(|(p, key, _)| {
-        let Some(point) = particle(*p) else {
-            return false;
-        };
-        let renamed = if *key & EDGE_KEY != 0 {
-            old.edges
-                .get((*key & !EDGE_KEY) as usize)
-                .and_then(|&(a, b)| Some((particle(a)?, particle(b)?)))
-                .and_then(|ends| edge_of.get(&ends))
-                .map(|&k| EDGE_KEY | k)
-        } else {
-            (old.strands.get(*key as usize)).and_then(|e| strand_of.get(e).copied())
-        };
-        let Some(renamed) = renamed else {
-            return false;
-        };
-        (*p, *key) = (point, renamed);
-        true
-    });
-    warm.sort_unstable_by_key(|&(p, k, _)| (p, k));
 }
 
 /// What a warm-started row meets, by entity.
@@ -138,9 +107,14 @@ pub fn keyed(named: &[NamedWarmStart], new: &NewIndices) -> Vec<(u32, u32, RowIm
     let strand_of: HashMap<Entity, u32> = (new.strands.iter().enumerate())
         .map(|(i, &e)| (e, i as u32))
         .collect();
-    let edge_of: HashMap<(u32, u32), u32> = (new.edges.iter().enumerate())
-        .map(|(k, e)| ((e.a, e.b), k as u32))
-        .collect();
+    let corners = named.iter().any(|w| matches!(w.partner, Partner::Edge(..)));
+    let edge_of: HashMap<(u32, u32), u32> = if corners {
+        (new.edges.iter().enumerate())
+            .map(|(k, e)| ((e.a, e.b), k as u32))
+            .collect()
+    } else {
+        HashMap::default()
+    };
     let particle = |e: &Entity| new.particles.get(e).copied();
     let mut warm: Vec<(u32, u32, RowImpulse)> = (named.iter())
         .filter_map(|w| {
@@ -176,11 +150,12 @@ mod tests {
         };
         let mut old = Numbering::default();
         old.record(
+            1,
             &(0..6).map(e).collect::<Vec<_>>(),
             &[e(10), e(11)],
             &edges(&[(0, 1), (1, 2), (3, 4), (4, 5)]),
         );
-        let mut warm = vec![
+        let warm = vec![
             (0, 1, impulse(1.0)),            // point e0 on strand s11
             (3, 0, impulse(2.0)),            // point e3 on strand s10
             (4, EDGE_KEY | 1, impulse(3.0)), // point e4 on edge e1–e2
@@ -194,9 +169,8 @@ mod tests {
             .collect();
         let new_edges = edges(&[(0, 1), (2, 3), (3, 4), (5, 6)]);
         let strands = [e(12), e(11), e(10)];
-        renumber(
-            &mut warm,
-            &old,
+        let warm = keyed(
+            &named(&warm, &old),
             &NewIndices {
                 particles: &index,
                 strands: &strands,
@@ -218,19 +192,17 @@ mod tests {
         let particles: Vec<Entity> = (0..4).map(e).collect();
         let edges = vec![Edge::new(0, 1, 1.0), Edge::new(2, 3, 1.0)];
         let mut old = Numbering::default();
-        old.record(&particles, &[e(10), e(11)], &edges);
+        old.record(1, &particles, &[e(10), e(11)], &edges);
         let warm0 = vec![
             (0, 1, impulse(1.0)),
             (1, EDGE_KEY | 1, impulse(2.0)),
             (3, 0, impulse(3.0)),
         ];
-        let mut warm = warm0.clone();
         let index: EntityHashMap<u32> = (particles.iter().enumerate())
             .map(|(i, &entity)| (entity, i as u32))
             .collect();
-        renumber(
-            &mut warm,
-            &old,
+        let warm = keyed(
+            &named(&warm0, &old),
             &NewIndices {
                 particles: &index,
                 strands: &[e(10), e(11)],
