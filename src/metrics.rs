@@ -57,6 +57,10 @@ pub struct IterationStats {
     /// The contact Newton's sparse factorizations.
     #[cfg_attr(feature = "serde", serde(default))]
     pub factorizations: u64,
+    /// Contact projections whose sweeps left a squeezed pair short and that the
+    /// contact Newton solved again (counted in `newton_solves` too).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub escalated: u64,
     /// Solves whose island was stepped again in substeps after one projection failed.
     #[cfg_attr(feature = "serde", serde(default))]
     pub restepped: u64,
@@ -98,6 +102,7 @@ impl IterationStats {
         self.rejected += other.rejected;
         self.newton_solves += other.newton_solves;
         self.factorizations += other.factorizations;
+        self.escalated += other.escalated;
         self.restepped += other.restepped;
         self.substeps += other.substeps;
     }

@@ -160,6 +160,9 @@ pub struct Report {
     pub contact_projection_newton_solves: u64,
     /// The contact Newton's sparse factorizations.
     pub contact_projection_factorizations: u64,
+    /// Of the Newton's projections, those solved again after the sweeps left a
+    /// squeezed pair short.
+    pub contact_projection_escalated: u64,
     /// Steps whose collisions still needed impulses after the last re-projection:
     /// edges next to those contacts end the step as the impulses left them.
     pub contact_unsettled_steps: u64,
@@ -272,9 +275,10 @@ impl Report {
             (
                 "contact_projection",
                 format!(
-                    "{} solves ({} by Newton, {} factorizations), mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
+                    "{} solves ({} by Newton, {} of them after the sweeps, {} factorizations), mean {:.2}, max {}, capped {}, rejected {}; unsettled steps {}",
                     self.contact_projection_solves,
                     self.contact_projection_newton_solves,
+                    self.contact_projection_escalated,
                     self.contact_projection_factorizations,
                     self.contact_projection_iterations_mean,
                     self.contact_projection_iterations_max,

@@ -570,6 +570,7 @@ fn report(
         contact_projection_solves: metrics.contact_projection.solves,
         contact_projection_newton_solves: metrics.contact_projection.newton_solves,
         contact_projection_factorizations: metrics.contact_projection.factorizations,
+        contact_projection_escalated: metrics.contact_projection.escalated,
         contact_projection_iterations_mean: metrics.contact_projection.mean(),
         contact_projection_iterations_max: metrics.contact_projection.max,
         contact_projection_capped_solves: metrics.contact_projection.capped,

@@ -377,6 +377,7 @@ impl Lane {
             ..Default::default()
         });
         self.stats.record_factorizations(outcome.factorizations);
+        self.stats.escalated += u64::from(outcome.escalated);
         self.total.iterations = self.total.iterations.max(outcome.iterations);
         self.total.sweeps += outcome.sweeps;
         self.total.converged &= outcome.converged;

@@ -117,4 +117,7 @@ pub struct ContactOutcome {
     pub contact_violation: f64,
     /// Sparse factorizations of the contact Newton.
     pub factorizations: u32,
+    /// Whether `Auto` solved a group again by the contact Newton because its sweeps
+    /// left a squeezed pair's row short.
+    pub escalated: bool,
 }

@@ -414,6 +414,15 @@ impl<'a> CutSweeps<'_, 'a> {
 impl Sweeps {
     /// How far (a distance per step) the most violated normal row falls short at the
     /// current corrections.
+    /// How far (a distance per step) `row`'s normal part falls short at the current
+    /// corrections (negative: met with room to spare).
+    pub(super) fn row_shortfall(s: &ContactScratch, row: &LocalRow) -> f64 {
+        if row.count == 0 {
+            return 0.0;
+        }
+        -(row.slack_n + moved(s.correction.as_slice(), row, row.normal))
+    }
+
     pub(super) fn shortfall(s: &ContactScratch) -> f64 {
         let correction = s.correction.as_slice();
         s.rows
