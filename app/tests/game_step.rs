@@ -356,10 +356,10 @@ fn a_pile_landing_is_not_thrown_back_up_by_its_own_squeeze() {
             metrics.contact_projection.solves
         );
         assert!(events.is_empty(), "{name}: {events:?}");
-        // 9.7 J at 1/300 and 9.1 J at 1/60 (12 100 J at the start); 244 J and 356 J
-        // without the Newton's second solve.
+        // 5.3 J at 1/300 and 3.7 J at 1/60 (12 100 J at the start); 244 J and 356 J
+        // without the hand-over to the Newton.
         assert!(
-            ledger.largest_rise < 30.0,
+            ledger.largest_rise < 15.0,
             "{name}: {} J",
             ledger.largest_rise
         );

@@ -357,6 +357,7 @@ mod tests {
                 max_correction: f64::INFINITY,
                 rows_give_way: 15,
                 solver: Default::default(),
+                newton_first: false,
             }
         }
 

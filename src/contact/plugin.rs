@@ -103,6 +103,7 @@ fn contact_settings(
         rows_give_way: (u64::from(constraints.max_iterations) * u64::from(give_way.0)
             / u64::from(give_way.1.max(1))) as u32,
         solver: contact.solver,
+        newton_first: false,
     }
 }
 

@@ -100,6 +100,9 @@ pub struct ContactSettings {
     pub resting: Option<Resting>,
     /// How the rows' impulses are found.
     pub solver: ContactSolver,
+    /// Under `Auto`, go to the contact Newton without trying the sweeps first (the
+    /// group's sweeps recently left a squeezed pair short).
+    pub newton_first: bool,
 }
 
 /// How a contact projection ended.
@@ -120,4 +123,6 @@ pub struct ContactOutcome {
     /// Whether `Auto` solved a group again by the contact Newton because its sweeps
     /// left a squeezed pair's row short.
     pub escalated: bool,
+    /// Whether `Auto` went to the contact Newton first ([`ContactSettings::newton_first`]).
+    pub newton_first: bool,
 }
