@@ -77,17 +77,21 @@ pub fn project_with_contacts(
         loose,
     };
     (scratch.cut).cut(members, position, inverse_mass, rows, impulses);
-    lay_out(
-        set,
-        islands,
-        loose,
-        position,
-        velocity,
-        inverse_mass,
-        dt,
-        scratch,
-    );
-    localize_rows(rows, impulses, velocity, dt, scratch);
+    // The iteration's start: the parts laid out, the rows localized and warm-started.
+    let start = |scratch: &mut ContactScratch| {
+        lay_out(
+            set,
+            islands,
+            loose,
+            position,
+            velocity,
+            inverse_mass,
+            dt,
+            scratch,
+        );
+        localize_rows(rows, impulses, velocity, dt, scratch);
+    };
+    start(scratch);
     // A group at rest is met closely by the sweeps (the contact Newton meets its rows
     // to their fixed point whatever the tolerance).
     let resting = match settings.resting {
@@ -117,17 +121,7 @@ pub fn project_with_contacts(
         // The sweeps left squeezed pairs short (a landing's stack, a pile at a game's
         // step): met over the next steps, their push-out lifts the pile. Solve the
         // group again from the same start by the contact Newton, which meets them.
-        lay_out(
-            set,
-            islands,
-            loose,
-            position,
-            velocity,
-            inverse_mass,
-            dt,
-            scratch,
-        );
-        localize_rows(rows, impulses, velocity, dt, scratch);
+        start(scratch);
         let newton = ContactSettings {
             solver: ContactSolver::Newton,
             ..*settings
