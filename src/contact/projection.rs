@@ -102,11 +102,11 @@ pub fn project_with_contacts(
         }),
         _ => None,
     };
-    // A group whose sweeps recently fell short goes to the contact Newton first: the
-    // sweeps it would spend first are most of what an escalated step costs.
-    let newton_first = settings.newton_first
-        && settings.solver == ContactSolver::Auto
-        && !driven(scratch, velocity);
+    // Only `Auto` hands a group to the Newton, and never a driven one (see
+    // [`escalates`]). One whose sweeps recently fell short goes to the Newton first:
+    // the sweeps it would spend first are most of what an escalated step costs.
+    let may_hand_over = settings.solver == ContactSolver::Auto && !driven(scratch, velocity);
+    let newton_first = settings.newton_first && may_hand_over;
     let first = ContactSettings {
         solver: if newton_first {
             ContactSolver::Newton
@@ -117,7 +117,7 @@ pub fn project_with_contacts(
     };
     let mut outcome = newton_steps(set, islands, &first, resting.as_ref(), scratch);
     outcome.newton_first = newton_first;
-    if escalates(&first, &outcome, scratch, rows, velocity) {
+    if may_hand_over && escalates(&first, &outcome, scratch, rows) {
         // The sweeps left squeezed pairs short (a landing's stack, a pile at a game's
         // step): met over the next steps, their push-out lifts the pile. Solve the
         // group again from the same start by the contact Newton, which meets them.
@@ -180,21 +180,19 @@ pub fn project_with_contacts(
 const ESCALATE_SHORTFALL: f64 = 0.25;
 
 /// Whether `Auto`'s sweeps (no factorization) left a squeezed pair's row of the group
-/// in `s` short by more than [`ESCALATE_SHORTFALL`] tolerances, in a group no driver
-/// moves: a driven group gains the driver's energy whatever its rows do, and the fur
-/// a driven body drags through itself at 1/60 s leaves such rows short at most steps
-/// (3.6× the wall time, nothing gained).
+/// in `s` short by more than [`ESCALATE_SHORTFALL`] tolerances. Asked only of a group
+/// no driver moves: a driven group gains the driver's energy whatever its rows do, and
+/// the fur a driven body drags through itself at 1/60 s leaves such rows short at most
+/// steps (3.6× the wall time, nothing gained).
 fn escalates(
     settings: &ContactSettings,
     outcome: &ContactOutcome,
     s: &ContactScratch,
     rows: &[ContactRow],
-    velocity: &[DVec2],
 ) -> bool {
     let least = ESCALATE_SHORTFALL * settings.contact_tolerance;
     settings.solver == ContactSolver::Auto
         && outcome.factorizations == 0
-        && !driven(s, velocity)
         && s.rows.iter().zip(&s.cut.rows).any(|(row, &c)| {
             rows.get(c as usize).is_some_and(|r| r.target > 0.0)
                 && Sweeps::row_shortfall(s, row) > least
@@ -570,6 +568,23 @@ mod tests {
             dt: f64,
             scratch: &mut ContactScratch,
         ) -> ContactOutcome {
+            let settings = ContactSettings {
+                solver,
+                ..settings()
+            };
+            self.project_with(&settings, velocity, rows, impulses, dt, scratch)
+        }
+
+        /// [`World::project`] under `settings`.
+        fn project_with(
+            &self,
+            settings: &ContactSettings,
+            velocity: &mut [DVec2],
+            rows: &[ContactRow],
+            impulses: &mut [RowImpulse],
+            dt: f64,
+            scratch: &mut ContactScratch,
+        ) -> ContactOutcome {
             let islands: Vec<u32> = (0..self.set.islands.len() as u32).collect();
             let in_island: Vec<u32> = self.set.edges.iter().flat_map(|e| [e.a, e.b]).collect();
             let loose: Vec<u32> = (0..self.position.len() as u32)
@@ -583,10 +598,7 @@ mod tests {
                 rows,
                 impulses,
                 dt,
-                &ContactSettings {
-                    solver,
-                    ..settings()
-                },
+                settings,
                 scratch,
             )
         }
@@ -1139,16 +1151,12 @@ mod tests {
                 contact_tolerance: 1e-10,
                 ..settings()
             };
-            let islands: Vec<u32> = (0..world.set.islands.len() as u32).collect();
-            let outcome = project_with_contacts(
-                &world.set,
-                &islands,
-                &[],
-                Bodies::new(&world.position, &mut velocity, &world.inverse_mass),
+            let outcome = world.project_with(
+                &settings,
+                &mut velocity,
                 &rows,
                 &mut impulses,
                 dt,
-                &settings,
                 &mut ContactScratch::default(),
             );
             assert!(outcome.converged, "{solver:?}: {outcome:?}");
@@ -1272,17 +1280,13 @@ mod tests {
         let project = |floor: DVec2, settings: &ContactSettings| {
             let (world, mut velocity, rows) = squeezed_stack(floor);
             assert!(rows.iter().all(|r| r.target > 0.0));
-            let islands: Vec<u32> = (0..world.set.islands.len() as u32).collect();
             let mut impulses = vec![RowImpulse::default(); rows.len()];
-            let outcome = project_with_contacts(
-                &world.set,
-                &islands,
-                &[],
-                Bodies::new(&world.position, &mut velocity, &world.inverse_mass),
+            let outcome = world.project_with(
+                settings,
+                &mut velocity,
                 &rows,
                 &mut impulses,
                 dt,
-                settings,
                 &mut ContactScratch::default(),
             );
             assert!(world.max_relative_error(&velocity, dt) < 1e-12);
