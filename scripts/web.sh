@@ -21,7 +21,8 @@ if [ "$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }')" != "$version" 
         || cargo install wasm-bindgen-cli --version "$version"
 fi
 
-cargo build --profile web --target wasm32-unknown-unknown -p bevy_strands_app \
+CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS="-C target-feature=+simd128" \
+    cargo build --profile web --target wasm32-unknown-unknown -p bevy_strands_app \
     --features web --example web
 mkdir -p "$out"
 wasm-bindgen --target web --no-typescript --remove-name-section --remove-producers-section --out-dir "$out" --out-name strands \

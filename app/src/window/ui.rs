@@ -113,7 +113,7 @@ impl Plugin for StrandsUiPlugin {
                 ..default()
             })
             .add_plugins(ScreenshotPlugin)
-            .add_systems(EguiPrimaryContextPass, panel)
+            .add_systems(EguiPrimaryContextPass, (use_embedded_font, panel).chain())
             .add_systems(Update, (shortcuts, use_tools, trim_history));
         // A page has no folder to write frames into, and leaves the encoders out.
         #[cfg(not(target_arch = "wasm32"))]
@@ -152,6 +152,28 @@ fn edit<T: Clone + PartialEq, R: DerefMut<Target = T>>(value: &mut R, change: im
     if copy != **value {
         **value = copy;
     }
+}
+
+/// The panel's one font: the DejaVu Sans Mono the exporters embed, in place of egui's
+/// four default fonts (1.4 MB, most of it emoji the panel never shows), for both of
+/// egui's families. Its labels keep to the glyphs it has.
+fn use_embedded_font(mut contexts: EguiContexts, mut done: Local<bool>) -> Result {
+    if *done {
+        return Ok(());
+    }
+    let mut fonts = egui::FontDefinitions::empty();
+    fonts.font_data.insert(
+        "DejaVuSansMono".to_owned(),
+        std::sync::Arc::new(egui::FontData::from_static(crate::export::text::FONT)),
+    );
+    for family in [egui::FontFamily::Proportional, egui::FontFamily::Monospace] {
+        fonts
+            .families
+            .insert(family, vec!["DejaVuSansMono".to_owned()]);
+    }
+    contexts.ctx_mut()?.set_fonts(fonts);
+    *done = true;
+    Ok(())
 }
 
 fn panel(
@@ -231,7 +253,7 @@ fn controls(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands)
     ui.horizontal(|ui| {
         let paused = settings.step.paused;
         if ui
-            .button(if paused { "▶ run" } else { "⏸ pause" })
+            .button(if paused { "▶ run" } else { "❚❚ pause" })
             .clicked()
         {
             settings.step.paused = !paused;
@@ -288,11 +310,11 @@ fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
             format!("{} ({})", m.edges, m.constrained_edges),
         );
         row(
-            "max |ℓ−L|/L now",
+            "max |l−L|/L now",
             format!("{:.2e}", m.max_rel_length_error_now),
         );
         row(
-            "max |ℓ−L|/L ever",
+            "max |l−L|/L ever",
             format!("{:.2e}", m.max_rel_length_error),
         );
         row(
@@ -329,7 +351,7 @@ fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
         .allow_scroll(false)
         .allow_drag(false)
         .y_axis_formatter(|mark, _| format!("1e{:.0}", mark.value))
-        .show(ui, |plot| plot.line(Line::new("max |ℓ−L|/L", points)));
+        .show(ui, |plot| plot.line(Line::new("max |l−L|/L", points)));
     if let Some(problem) = figures.problems.entries.last() {
         ui.colored_label(
             egui::Color32::LIGHT_RED,
