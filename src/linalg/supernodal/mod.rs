@@ -624,11 +624,23 @@ fn extend_add(
     let relative = &plan.relative[start + w..end];
     let top = updates.len() - b * b;
     let update = &updates[top..];
+    // The child's rows land mostly in runs of consecutive parent rows: each run is added
+    // as one slice (every entry still gets its one addition, so the sums are the same).
     for (c, &rc) in relative.iter().enumerate() {
         let column = &update[c * b..(c + 1) * b];
         let base = rc as usize * m;
-        for (r, &x) in relative.iter().zip(column).skip(c) {
-            front[base + *r as usize] += x;
+        let mut r = c;
+        while r < b {
+            let first = relative[r] as usize;
+            let mut end = r + 1;
+            while end < b && relative[end] as usize == first + (end - r) {
+                end += 1;
+            }
+            let target = &mut front[base + first..base + first + (end - r)];
+            for (t, &x) in target.iter_mut().zip(&column[r..end]) {
+                *t += x;
+            }
+            r = end;
         }
     }
     updates.truncate(top);
