@@ -535,3 +535,71 @@ fn trim_history(mut history: ResMut<LengthErrorHistory>) {
         history.samples.drain(..excess);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use ab_glyph::Font;
+
+    /// The characters inside the string literals of `source` (comments skipped).
+    fn literal_chars(source: &str) -> Vec<char> {
+        let (mut found, mut chars) = (Vec::new(), source.chars().peekable());
+        let mut in_string = false;
+        while let Some(c) = chars.next() {
+            match (in_string, c) {
+                (true, '\\') => {
+                    chars.next();
+                }
+                (true, '"') => in_string = false,
+                (true, c) => found.push(c),
+                (false, '"') => in_string = true,
+                (false, '/') if chars.peek() == Some(&'/') => {
+                    for c in chars.by_ref() {
+                        if c == '\n' {
+                            break;
+                        }
+                    }
+                }
+                // A character literal ('"' among them); a lifetime's quote stands alone.
+                (false, '\'') => {
+                    let mut ahead = chars.clone();
+                    let first = ahead.next();
+                    if first == Some('\\') {
+                        ahead.next();
+                    }
+                    if ahead.next() == Some('\'') {
+                        chars = ahead;
+                    }
+                }
+                _ => {}
+            }
+        }
+        found
+    }
+
+    /// egui draws a box for a character its font lacks: every character the panel's
+    /// labels, tool names and menus are written with has a glyph in the one font.
+    #[test]
+    fn the_panel_font_has_a_glyph_for_every_character_its_labels_use() {
+        let font = crate::export::text::font();
+        let sources = [
+            include_str!("ui.rs"),
+            include_str!("tools.rs"),
+            include_str!("mod.rs"),
+        ];
+        // The code above each file's tests (these tests write missing glyphs on purpose).
+        let used: Vec<char> = (sources.iter())
+            .flat_map(|s| literal_chars(s.split("#[cfg(test)]").next().unwrap_or(s)))
+            .collect();
+        // The scan finds the labels' own marks (so that it cannot pass by finding none).
+        for mark in ['▶', '·', '−'] {
+            assert!(used.contains(&mark), "{mark} not found in the labels");
+        }
+        let missing: Vec<char> = (used.iter().copied())
+            .filter(|&c| !c.is_ascii_control() && font.glyph_id(c).0 == 0)
+            .collect();
+        assert!(missing.is_empty(), "no glyph for {missing:?}");
+        // The scan itself: an escaped quote, a comment, a quote as a character, a lifetime.
+        let sample = "let a = \"x\\\"ℓ\"; // \"⏸\"\nlet c = '\"'; let b: &'static str = \"·\";";
+        assert_eq!(literal_chars(sample), ['x', 'ℓ', '·']);
+    }
+}
