@@ -1270,6 +1270,40 @@ mod tests {
     }
 
     #[test]
+    fn a_newton_that_keeps_its_analysis_answers_as_a_fresh_one_bit_for_bit() {
+        // The squeezed stack with all its rows (A) and with its top layer's rows gone
+        // (B: another pattern), projected in turn by one scratch, which keeps the last
+        // pattern's analysis and plan, and each by a fresh scratch.
+        let dt = 1.0 / 60.0;
+        let (world, start, rows) = squeezed_stack(DVec2::ZERO);
+        let fewer = &rows[..rows.len() - 2];
+        let project = |rows: &[ContactRow], scratch: &mut ContactScratch| {
+            let (mut velocity, mut impulses) =
+                (start.clone(), vec![RowImpulse::default(); rows.len()]);
+            let outcome = world.project(&mut velocity, rows, &mut impulses, dt, scratch);
+            assert!(outcome.factorizations > 0, "{outcome:?}");
+            let bits = |v: &[DVec2]| {
+                v.iter()
+                    .flat_map(|v| [v.x.to_bits(), v.y.to_bits()])
+                    .collect::<Vec<_>>()
+            };
+            (bits(&velocity), impulses)
+        };
+        let fresh_a = project(&rows, &mut ContactScratch::default());
+        let fresh_b = project(fewer, &mut ContactScratch::default());
+        assert_ne!(fresh_a.0, fresh_b.0);
+        let mut kept = ContactScratch::default();
+        for (rows, fresh) in [
+            (&rows[..], &fresh_a),
+            (&rows[..], &fresh_a),
+            (fewer, &fresh_b),
+            (&rows[..], &fresh_a),
+        ] {
+            assert_eq!(&project(rows, &mut kept), fresh);
+        }
+    }
+
+    #[test]
     fn sweeps_that_leave_a_squeezed_pair_short_hand_the_group_to_the_newton() {
         let dt = 1.0 / 60.0;
         let few_sweeps = ContactSettings {

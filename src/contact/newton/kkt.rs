@@ -83,6 +83,9 @@ pub(super) struct Kkt {
     /// Where the edges' curvature couplings start (two per edge with two free ends).
     curvature_first: u32,
     pattern: LdlPattern,
+    /// The pattern (`start`, `row`) the analysis and plan were last made for.
+    analyzed_start: Vec<u32>,
+    analyzed_row: Vec<u32>,
     flag: Vec<u32>,
     value: Vec<f64>,
     plan: SupernodalPlan,
@@ -113,8 +116,14 @@ impl Kkt {
         self.order_particles();
         self.assign(input);
         self.contributions(input);
-        self.pattern.analyze(&mut self.flag);
-        self.plan.plan(&self.pattern);
+        // A contact set that holds from one projection to the next (a strand resting on
+        // the floor) asks for the same pattern: its analysis and plan are kept.
+        if self.pattern.start != self.analyzed_start || self.pattern.row != self.analyzed_row {
+            self.pattern.analyze(&mut self.flag);
+            self.plan.plan(&self.pattern);
+            self.analyzed_start.clone_from(&self.pattern.start);
+            self.analyzed_row.clone_from(&self.pattern.row);
+        }
     }
 
     /// The particles' elimination order: approximate minimum degree (Amestoy, Davis
