@@ -9,7 +9,8 @@
 //! The particles are ordered by geometric nested dissection (`ordering`), each edge's
 //! multiplier right after the later of its two particles, so the sparse LDLᵀ
 //! (`linalg::symbolic`) needs no pivoting. The pattern holds every row of the projection, pressed
-//! or not, and is analysed once per projection; each Newton step only refills values.
+//! or not, and is analysed once per projection (and kept while the next projection asks
+//! for the same pattern); each Newton step only refills values.
 
 use bevy::math::DVec2;
 
