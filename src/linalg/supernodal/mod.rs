@@ -32,6 +32,9 @@ pub struct SupernodalPlan {
     rows: Vec<u32>,
     /// Where each supernode's rows below its columns sit in its parent's front.
     relative: Vec<u32>,
+    /// How many rows from each of those on land in consecutive parent rows: the
+    /// extend-add adds a run as one slice.
+    run: Vec<u32>,
     /// Each supernode's number of children (their updates are on the stack).
     children: Vec<u32>,
     /// Where each supernode's factor panel (front rows × width) starts.
@@ -350,6 +353,8 @@ impl SupernodalPlan {
         // the update stack holds (children's updates wait for their parent).
         self.relative.clear();
         self.relative.resize(self.rows.len(), NONE);
+        self.run.clear();
+        self.run.resize(self.rows.len(), 0);
         w.held.clear();
         self.stack = 0;
         let mut held = 0;
@@ -368,6 +373,10 @@ impl SupernodalPlan {
                     let found = self.rows[from..to].binary_search(&r);
                     self.relative[i] =
                         found.expect("a child's rows are in its parent's front") as u32;
+                }
+                for i in (start + width..end).rev() {
+                    let next = i + 1 < end && self.relative[i + 1] == self.relative[i] + 1;
+                    self.run[i] = if next { self.run[i + 1] + 1 } else { 1 };
                 }
             }
             let b = end - start - width;
@@ -622,6 +631,7 @@ fn extend_add(
     );
     let b = end - start - w;
     let relative = &plan.relative[start + w..end];
+    let run = &plan.run[start + w..end];
     let top = updates.len() - b * b;
     let update = &updates[top..];
     // The child's rows land mostly in runs of consecutive parent rows: each run is added
@@ -631,16 +641,12 @@ fn extend_add(
         let base = rc as usize * m;
         let mut r = c;
         while r < b {
-            let first = relative[r] as usize;
-            let mut end = r + 1;
-            while end < b && relative[end] as usize == first + (end - r) {
-                end += 1;
-            }
-            let target = &mut front[base + first..base + first + (end - r)];
-            for (t, &x) in target.iter_mut().zip(&column[r..end]) {
+            let (first, length) = (relative[r] as usize, run[r] as usize);
+            let target = &mut front[base + first..base + first + length];
+            for (t, &x) in target.iter_mut().zip(&column[r..r + length]) {
                 *t += x;
             }
-            r = end;
+            r += length;
         }
     }
     updates.truncate(top);
