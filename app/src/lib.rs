@@ -4,7 +4,7 @@
 //! files ([`scenario`], [`spawn`], the [`builtin`] ones), the demo factories and the furry creature
 //! ([`scenes`]), the headless runner, its report and its snapshots ([`runner`],
 //! [`report`], [`snapshot`]), pictures
-//! of runs ([`export`]), the windowed demos (feature `render`, [`window`]), and the
+//! of runs ([`export`]), the windowed demos (features `window` and `render`, [`window`]), and the
 //! fixtures the tests and benchmarks share ([`fixtures`]). The `strands` binary is a
 //! thin command line over [`runner::run`].
 
@@ -24,6 +24,6 @@ pub mod scenes;
 pub mod shape;
 pub mod snapshot;
 pub mod spawn;
-#[cfg(feature = "render")]
+#[cfg(feature = "window")]
 pub mod window;
 pub mod worlds;

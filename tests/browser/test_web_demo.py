@@ -4,8 +4,10 @@
 Serves the folder scripts/web.sh wrote, opens each factory and the rope, lets each run
 a few simulated seconds, and checks what a visitor would see: frames drawn (a
 screenshot that is not blank), the live figures the page receives (finite, every edge
-within 1e-9 of its length, no crossing, particles arriving), and a rope dragged by the
-mouse. Prints each scene's figures, real-time factor included.
+within 1e-9 of its length, no crossing, particles arriving), a rope dragged by the
+mouse, and the page's own panel (pause, step, run, the step size, a tool, a bad command
+refused with its reason, the scene switched in place). Prints each scene's figures,
+real-time factor included.
 
 Usage: python3 tests/browser/test_web_demo.py [folder, default target/web-demo]
 Needs the Python package playwright and Debian's chromium (/usr/bin/chromium); it never
@@ -148,7 +150,9 @@ def check_frames(page, out, name):
     png = page.locator("#strands").screenshot()
     (out / f"browser_{name}.png").write_bytes(png)
     colours, share = drawn(png)
-    check(colours >= 20 and share >= 0.02,
+    # The canvas holds the scene alone (the panel is the page's HTML): the box's outline
+    # is a third of a percent of it, a blank canvas one colour.
+    check(colours >= 20 and share >= 0.01,
           f"{name}: the canvas looks blank ({colours} colours, {share:.1%} not background)")
     return colours, share
 
@@ -251,6 +255,54 @@ def rope(page, url, out):
     report("rope (dragged 300 px up and let go)", f, colours, share)
 
 
+def panel(page, url):
+    """The page's HTML panel drives the simulation through its commands."""
+    page.goto(f"{url}/?scene=long_strand")
+    wait_for(page, lambda f: f["steps"] > 0 and f["frames"] >= 2, LOAD_TIMEOUT,
+             "the rope to start")
+    page.click("#pause")
+    paused = wait_for(page, lambda f: f["paused"], 30, "the pause button to pause")
+    page.wait_for_timeout(1000)
+    still = figures(page)
+    check(still["steps"] == paused["steps"] and still["time"] == paused["time"],
+          f"the clock ran while paused: {paused['steps']} -> {still['steps']} steps")
+    check(page.inner_text("#pause").endswith("run"), "the pause button does not offer to run")
+    page.click("button[data-command=step]")
+    stepped = wait_for(page, lambda f: f["steps"] > still["steps"], 30, "a step")
+    check(stepped["steps"] == still["steps"] + still["substeps"] and stepped["paused"],
+          f"step took {stepped['steps'] - still['steps']} steps, not one tick of "
+          f"{still['substeps']}, or ran on")
+    page.select_option("#dt", "0.016666666666666666")
+    page.fill("#substeps", "2")
+    page.dispatch_event("#substeps", "change")
+    page.click("button[data-tool=pin]")
+    f = wait_for(page, lambda f: f["tool"] == "pin" and f["substeps"] == 2
+                 and abs(f["dt"] - 1 / 60) < 1e-12, 30, "dt, substeps and tool to be set")
+    page.wait_for_timeout(300)
+    check(page.get_attribute("button[data-tool=pin]", "aria-pressed") == "true",
+          "the pin tool's button is not shown pressed")
+    # A bad command (as a script on the page might send) is refused and said why.
+    page.eval_on_selector("#strands-commands", "e => e.textContent += 'dt 7\\n'")
+    wait_for(page, lambda f: f["message"] is not None and "outside" in f["message"], 30,
+             "the bad command's reason")
+    page.wait_for_timeout(300)
+    check("outside" in page.inner_text("#message"), "the panel does not show the refusal")
+    check(abs(figures(page)["dt"] - 1 / 60) < 1e-12, "a refused dt changed the step")
+    page.click("#pause")
+    ran = wait_for(page, lambda f: not f["paused"] and f["steps"] > stepped["steps"] + 4, 60,
+                   "run to start the clock again")
+    check_exact(ran, "the rope at 1/60 s")
+    page.select_option("#scene", "meatball_factory")
+    f = wait_for(page, lambda f: f["scene"] == "meatball_factory" and f["steps"] > 0, 60,
+                 "the scene menu to switch to the meatball factory")
+    check("scene=meatball_factory" in page.url, f"the address was not updated: {page.url}")
+    check_exact(f, "meatball_factory after the switch")
+    print(f"panel: paused at {paused['steps']} steps, one tick of {still['substeps']} steps "
+          f"taken, dt 1/60 s with 2 substeps and the pin tool set, 'dt 7' refused "
+          f"({f['message'] or 'cleared'}), run to {ran['steps']} steps, switched to "
+          f"{f['scene']} in place", flush=True)
+
+
 def main():
     folder = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/web-demo")
     check((folder / "index.html").exists() and (folder / "strands_bg.wasm").exists(),
@@ -266,6 +318,7 @@ def main():
             factory(page, url, folder, "spaghetti_factory", 3.0)
             factory(page, url, folder, "meatball_factory", 3.0)
             rope(page, url, folder)
+            panel(page, url)
             browser.close()
     finally:
         server.shutdown()

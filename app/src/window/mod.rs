@@ -17,11 +17,14 @@
 
 #[cfg(any(feature = "avian", feature = "rapier"))]
 pub mod bodies;
+pub mod command;
+mod controls;
 mod layout;
 mod pace;
 pub mod page;
 mod screenshot;
 mod tools;
+#[cfg(feature = "render")]
 mod ui;
 mod view;
 
@@ -35,11 +38,11 @@ use crate::scenario::{Scenario, ScenarioError};
 use crate::scenes::ScenesPlugin;
 use crate::spawn::spawn_scenario;
 
+pub use controls::{FrameExport, StrandsUiPlugin, UiKeys, reset, switch_scenario};
 pub use layout::UiLayout;
 pub use pace::{PacePlugin, RealTimeFactor};
 pub use screenshot::ScreenshotPlugin;
 pub use tools::{Tool, ToolState};
-pub use ui::{StrandsUiPlugin, UiKeys};
 pub use view::DemoViewPlugin;
 
 /// Bevy's default plugins for an example window: 1280×720, titled. On the web the

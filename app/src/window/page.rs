@@ -1,19 +1,29 @@
-//! The demo inside a web page (the `web` example): which scene the page asks for, and
-//! the live figures handed to the page. On wasm32 with the `web` feature the figures are
-//! written each frame as JSON into the page's `#strands-figures` element, where the
-//! visitor reads them and a browser test parses them; elsewhere they are only computed.
+//! The demo inside a web page (the `web` example): which scene the page asks for, the
+//! live figures handed to the page, and the commands its controls send. On wasm32 with
+//! the `web` feature the figures are written each frame as JSON into the page's
+//! `#strands-figures` element, where the page's panel shows them and a browser test
+//! parses them, and the lines the page's buttons write into `#strands-commands` are
+//! carried out (see [`super::command`]); elsewhere the figures are only computed.
 
 use bevy::diagnostic::FrameCount;
 use bevy::prelude::*;
 use bevy_strands::prelude::*;
 use serde::Serialize;
 
-use super::ActiveScenario;
+#[cfg(all(feature = "web", target_arch = "wasm32"))]
+use super::command::run_commands;
 use super::pace::RealTimeFactor;
 use super::tools::ToolState;
+use super::{ActiveScenario, ScenarioMenu};
 
 /// The id of the page element the figures are written into.
 pub const FIGURES_ELEMENT: &str = "strands-figures";
+/// The id of the page element its controls write their commands into, one a line.
+pub const COMMANDS_ELEMENT: &str = "strands-commands";
+
+/// The last command of the page's that could not be carried out, and why.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct PageCommandError(pub Option<String>);
 
 /// What the page shows and a test reads: the panel's main figures.
 #[derive(Serialize, Clone, Debug, PartialEq)]
@@ -36,6 +46,18 @@ pub struct PageFigures {
     pub real_time_factor: Option<f64>,
     /// Frames drawn.
     pub frames: u32,
+    /// Whether the clock is stopped.
+    pub paused: bool,
+    /// The step size, in seconds.
+    pub dt: f64,
+    /// Steps per tick.
+    pub substeps: u32,
+    /// The mouse tool's name.
+    pub tool: String,
+    /// The scenes the page may switch to.
+    pub scenes: Vec<String>,
+    /// Why the last command that failed did, or why the last tool use failed.
+    pub message: Option<String>,
     /// The pointer's world position, when it is over the scene's window.
     pub cursor: Option<[f64; 2]>,
     /// Whether a particle is under the pointer (what a press would grab).
@@ -53,6 +75,10 @@ impl PageFigures {
         let clock = world.resource::<SimulationClock>();
         let real_time_factor = world.get_resource::<RealTimeFactor>().and_then(|r| r.value);
         let tools = world.get_resource::<ToolState>();
+        let config = world.resource::<StrandsConfig>();
+        let command_error = world.get_resource::<PageCommandError>();
+        let message = (command_error.and_then(|e| e.0.clone()))
+            .or_else(|| tools.and_then(|t| t.message.clone()));
         let finite = clock.time.is_finite()
             && metrics.max_rel_length_error.is_finite()
             && real_time_factor.is_none_or(f64::is_finite);
@@ -67,6 +93,12 @@ impl PageFigures {
             edge_crossings: metrics.edge_crossings,
             real_time_factor,
             frames: world.get_resource::<FrameCount>().map_or(0, |f| f.0),
+            paused: config.paused,
+            dt: config.dt,
+            substeps: config.substeps,
+            tool: tools.map_or("drag", |t| t.tool.label()).to_string(),
+            scenes: (world.get_resource::<ScenarioMenu>()).map_or(Vec::new(), |m| m.names.clone()),
+            message,
             cursor: tools.and_then(|t| t.cursor).map(|c| c.to_array()),
             hovering: tools.is_some_and(|t| t.hovered.is_some()),
             dragging: tools.is_some_and(|t| t.dragging().is_some()),
@@ -103,25 +135,47 @@ pub fn scene_in_query(search: &str) -> Option<String> {
         .map(str::to_string)
 }
 
-/// Hands the figures to the page each frame.
+/// Hands the figures to the page each frame, and carries out its controls' commands.
 pub struct PageFiguresPlugin;
 
 impl Plugin for PageFiguresPlugin {
     fn build(&self, app: &mut App) {
+        app.init_resource::<PageCommandError>();
         #[cfg(all(feature = "web", target_arch = "wasm32"))]
-        app.add_systems(Last, write_figures);
-        let _ = app;
+        app.add_systems(First, read_commands)
+            .add_systems(Last, write_figures);
     }
+}
+
+/// The page's element of id `id`, if the page has one.
+#[cfg(all(feature = "web", target_arch = "wasm32"))]
+fn element(id: &str) -> Option<web_sys::Element> {
+    web_sys::window()?.document()?.get_element_by_id(id)
+}
+
+/// Take the lines the page's controls wrote since the last frame and carry them out.
+#[cfg(all(feature = "web", target_arch = "wasm32"))]
+fn read_commands(world: &mut World) {
+    let Some(element) = element(COMMANDS_ELEMENT) else {
+        return;
+    };
+    let Some(text) = element.text_content().filter(|t| !t.trim().is_empty()) else {
+        return;
+    };
+    element.set_text_content(None);
+    let errors = run_commands(world, &text);
+    for e in &errors {
+        warn!("bevy_strands: the page's command failed: {e}");
+    }
+    // The newest failure shows until a later command succeeds.
+    world.resource_mut::<PageCommandError>().0 = errors.last().cloned();
 }
 
 #[cfg(all(feature = "web", target_arch = "wasm32"))]
 fn write_figures(world: &mut World) {
     let json = PageFigures::read(world).to_json();
-    let element = web_sys::window()
-        .and_then(|w| w.document())
-        .and_then(|d| d.get_element_by_id(FIGURES_ELEMENT));
     // A page without the element shows no figures; the demo runs on.
-    if let Some(element) = element {
+    if let Some(element) = element(FIGURES_ELEMENT) {
         element.set_text_content(Some(&json));
     }
 }
@@ -149,6 +203,7 @@ mod tests {
         let mut world = World::new();
         world.init_resource::<StrandMetrics>();
         world.init_resource::<SimulationClock>();
+        world.init_resource::<StrandsConfig>();
         world.resource_mut::<SimulationClock>().time = 1.5;
         let figures = PageFigures::read(&world);
         assert!(figures.finite);

@@ -1,9 +1,8 @@
-//! The egui panel (run, pause, step, reset; the step, forces, solver and collision
-//! settings; live figures and a plot of the length error), keyboard shortcuts, reset
-//! and frame export.
+//! The egui panel of the desktop demos (feature `render`): run, pause, step, reset; the
+//! step, forces, solver and collision settings; live figures and a plot of the length
+//! error. What its buttons do lives in [`super::controls`], shared with the web page.
 
 use std::ops::DerefMut;
-use std::path::PathBuf;
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
@@ -15,109 +14,22 @@ use bevy_strands::prelude::*;
 use bevy_strands::render::DrawSettings;
 use bevy_strands::world::clock::StepTiming;
 
+use super::command::{DT_RANGE, SUBSTEPS_RANGE};
+use super::controls::{FrameExport, UiKeys, reset, switch_scenario};
 use super::layout::UiLayout;
 use super::pace::RealTimeFactor;
-use super::screenshot::ScreenshotPlugin;
-use super::tools::{Tool, ToolState, use_tools};
-use super::{ActiveScenario, ScenarioMenu, spawn_active_scenario};
-use crate::export::{FrameSettings, Recorder};
-use crate::scenes::furry_creature::FurryCreature;
-use crate::scenes::meatball_factory::MeatballFactory;
-use crate::scenes::spaghetti_factory::SpaghettiFactory;
+use super::tools::{Tool, ToolState};
+use super::{ActiveScenario, ScenarioMenu};
 
-/// PNG frames written while recording (the E key).
-#[derive(Resource, Default)]
-pub struct FrameExport {
-    recorder: Option<Recorder>,
-    /// Where frames go.
-    pub directory: PathBuf,
-    /// The last export error, shown in the panel.
-    pub message: Option<String>,
-}
+/// The egui panel, added by [`super::StrandsUiPlugin`] when the `render` feature is on.
+pub(super) struct PanelPlugin;
 
-/// Samples of the error plot kept: older ones are dropped.
-const PLOT_SAMPLES: usize = 20_000;
-
-/// The panel, the mouse tools, the shortcuts, frame export and the opt-in screenshot.
-pub struct StrandsUiPlugin;
-
-/// The panel's keyboard shortcuts; `None` turns one off, [`UiKeys::none`] all of them.
-#[derive(Resource, Clone, Debug, PartialEq)]
-pub struct UiKeys {
-    /// Run or pause the simulation.
-    pub pause: Option<KeyCode>,
-    /// Restart the scenario.
-    pub reset: Option<KeyCode>,
-    /// Start or stop recording frames.
-    pub record: Option<KeyCode>,
-    /// One more substep per tick.
-    pub more_substeps: Option<KeyCode>,
-    /// One substep fewer per tick.
-    pub fewer_substeps: Option<KeyCode>,
-}
-
-impl Default for UiKeys {
-    fn default() -> Self {
-        Self {
-            pause: Some(KeyCode::Space),
-            reset: Some(KeyCode::KeyR),
-            record: Some(KeyCode::KeyE),
-            more_substeps: Some(KeyCode::Equal),
-            fewer_substeps: Some(KeyCode::Minus),
-        }
-    }
-}
-
-impl UiKeys {
-    /// No shortcuts: the game's keys are the game's.
-    pub fn none() -> Self {
-        Self {
-            pause: None,
-            reset: None,
-            record: None,
-            more_substeps: None,
-            fewer_substeps: None,
-        }
-    }
-
-    /// The help line the panel shows.
-    fn help(&self) -> String {
-        let name = |key: Option<KeyCode>, what: &str| {
-            key.map(|k| format!("{} {what}", format!("{k:?}").trim_start_matches("Key")))
-        };
-        [
-            name(self.pause, "run/pause"),
-            name(self.reset, "reset"),
-            name(self.record, "record frames"),
-            name(self.more_substeps, "more substeps"),
-            name(self.fewer_substeps, "fewer substeps"),
-        ]
-        .into_iter()
-        .flatten()
-        .collect::<Vec<_>>()
-        .join(" · ")
-    }
-}
-
-impl Plugin for StrandsUiPlugin {
+impl Plugin for PanelPlugin {
     fn build(&self, app: &mut App) {
         if !app.is_plugin_added::<EguiPlugin>() {
             app.add_plugins(EguiPlugin::default());
         }
-        app.init_resource::<ToolState>()
-            .init_resource::<UiKeys>()
-            .init_resource::<UiLayout>()
-            .init_resource::<LengthErrorHistory>()
-            .insert_resource(FrameExport {
-                directory: PathBuf::from("frames"),
-                ..default()
-            })
-            .add_plugins(ScreenshotPlugin)
-            .add_systems(EguiPrimaryContextPass, (use_embedded_font, panel).chain())
-            .add_systems(Update, (shortcuts, use_tools, trim_history));
-        // A page has no folder to write frames into, and leaves the encoders out.
-        #[cfg(not(target_arch = "wasm32"))]
-        app.add_systems(PostUpdate, export_frames);
+        app.add_systems(EguiPrimaryContextPass, (use_embedded_font, panel).chain());
     }
 }
 
@@ -238,13 +150,10 @@ fn scenario_menu(ui: &mut egui::Ui, menu: &ScenarioMenu, current: &str, commands
             }
         });
     if chosen != current {
-        let menu = menu.clone();
-        commands.queue(move |world: &mut World| match menu.scenario(&chosen) {
-            Ok(active) => {
-                world.insert_resource(active);
-                reset(world);
+        commands.queue(move |world: &mut World| {
+            if let Err(e) = switch_scenario(world, &chosen) {
+                error!("bevy_strands: {e}");
             }
-            Err(e) => error!("bevy_strands: {e}"),
         });
     }
 }
@@ -271,12 +180,12 @@ fn controls(ui: &mut egui::Ui, settings: &mut Settings, commands: &mut Commands)
             ui.label("dt");
             ui.add(
                 egui::DragValue::new(&mut step.dt)
-                    .range(1e-5..=1e-1)
+                    .range(DT_RANGE)
                     .speed(1e-5)
                     .custom_formatter(|v, _| format!("1/{:.0} s", 1.0 / v)),
             );
             ui.label("substeps");
-            ui.add(egui::DragValue::new(&mut step.substeps).range(1..=500));
+            ui.add(egui::DragValue::new(&mut step.substeps).range(SUBSTEPS_RANGE));
         });
         ui.add(egui::Slider::new(&mut step.gravity.y, -30.0..=0.0).text("gravity y"));
         ui.add(egui::Slider::new(&mut step.damping, 0.0..=5.0).text("damping"));
@@ -358,7 +267,7 @@ fn figures_ui(ui: &mut egui::Ui, figures: &Figures, settings: &Settings) {
             format!("{}: {}", problem.entity, problem.problem),
         );
     }
-    if figures.export.recorder.is_some() {
+    if figures.export.recording() {
         ui.colored_label(
             egui::Color32::LIGHT_GREEN,
             format!("recording frames to {}", figures.export.directory.display()),
@@ -422,120 +331,6 @@ fn solver_ui(ui: &mut egui::Ui, settings: &mut Settings) {
     });
 }
 
-/// The shortcuts of [`UiKeys`] (by default space run/pause, R reset, E record frames,
-/// = and − substeps).
-fn shortcuts(
-    keys: Res<ButtonInput<KeyCode>>,
-    bindings: Res<UiKeys>,
-    layout: Res<UiLayout>,
-    mut step: ResMut<StrandsConfig>,
-    mut collisions: ResMut<CollisionConfig>,
-    mut metrics: ResMut<StrandMetrics>,
-    mut commands: Commands,
-) {
-    if layout.keyboard_over_ui {
-        return;
-    }
-    let pressed = |key: Option<KeyCode>| key.is_some_and(|k| keys.just_pressed(k));
-    if pressed(bindings.pause) {
-        step.paused = !step.paused;
-    }
-    if pressed(bindings.reset) {
-        commands.queue(reset);
-    }
-    if pressed(bindings.record) && cfg!(not(target_arch = "wasm32")) {
-        commands.queue(toggle_export);
-    }
-    if pressed(bindings.more_substeps) {
-        step.substeps += 1;
-    }
-    if pressed(bindings.fewer_substeps) && step.substeps > 1 {
-        step.substeps -= 1;
-    }
-    // Crossings counted from when checking is switched on.
-    if collisions.is_changed() && collisions.check_crossings && metrics.edge_crossings.is_none() {
-        metrics.edge_crossings = Some(0);
-    }
-    if collisions.is_changed() && !collisions.check_crossings {
-        metrics.edge_crossings = None;
-    }
-    let _ = &mut collisions;
-}
-
-/// Start the scene over: despawn everything it made, clear the figures, spawn it again.
-pub fn reset(world: &mut World) {
-    let mut doomed = world.query_filtered::<Entity, Or<(
-        With<Particle>,
-        With<Strand>,
-        With<SpaghettiFactory>,
-        With<MeatballFactory>,
-        With<FurryCreature>,
-    )>>();
-    let doomed: Vec<Entity> = doomed.iter(world).collect();
-    for entity in doomed {
-        if let Ok(e) = world.get_entity_mut(entity) {
-            e.despawn();
-        }
-    }
-    *world.resource_mut::<SimulationClock>() = SimulationClock::default();
-    let checked = world.resource::<CollisionConfig>().check_crossings;
-    let mut metrics = world.resource_mut::<StrandMetrics>();
-    metrics.reset_figures();
-    metrics.edge_crossings = checked.then_some(0);
-    world.resource_mut::<LengthErrorHistory>().samples.clear();
-    world.resource_mut::<InputProblems>().clear();
-    spawn_active_scenario(world);
-}
-
-#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
-fn toggle_export(world: &mut World) {
-    let view = world
-        .get_resource::<ActiveScenario>()
-        .map(|a| a.scenario.view());
-    let title = world
-        .get_resource::<ActiveScenario>()
-        .map_or("bevy_strands".to_string(), |a| a.scenario.name.clone());
-    let mut export = world.resource_mut::<FrameExport>();
-    if export.recorder.take().is_some() {
-        return;
-    }
-    let Some(view) = view else {
-        return;
-    };
-    let directory = export.directory.clone();
-    match Recorder::new(
-        FrameSettings::default(),
-        view,
-        &title,
-        None,
-        Some(&directory),
-    ) {
-        Ok(recorder) => {
-            export.recorder = Some(recorder);
-            export.message = None;
-        }
-        Err(e) => export.message = Some(e.to_string()),
-    }
-}
-
-#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
-fn export_frames(world: &mut World) {
-    let Some(mut recorder) = world.resource_mut::<FrameExport>().recorder.take() else {
-        return;
-    };
-    match recorder.capture_if_due(world) {
-        Ok(()) => world.resource_mut::<FrameExport>().recorder = Some(recorder),
-        Err(e) => world.resource_mut::<FrameExport>().message = Some(e.to_string()),
-    }
-}
-
-fn trim_history(mut history: ResMut<LengthErrorHistory>) {
-    if history.samples.len() > PLOT_SAMPLES {
-        let excess = history.samples.len() - PLOT_SAMPLES / 2;
-        history.samples.drain(..excess);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use ab_glyph::Font;
@@ -583,6 +378,7 @@ mod tests {
         let font = crate::export::text::font();
         let sources = [
             include_str!("ui.rs"),
+            include_str!("controls.rs"),
             include_str!("tools.rs"),
             include_str!("mod.rs"),
         ];
