@@ -15,6 +15,13 @@ use bevy_strands_app::window::{DemoPlugins, ScenarioMenu, UiKeys, window_plugins
 const SCENES: [&str; 3] = ["spaghetti_factory", "meatball_factory", "long_strand"];
 
 fn main() -> AppExit {
+    let mut app = App::new();
+    // The plugins first: an unknown scene is then said in the log (the browser's console).
+    app.add_plugins(window_plugins("web demo")).add_plugins((
+        StrandsPlugin::default(),
+        DemoPlugins,
+        PageFiguresPlugin,
+    ));
     // Small scenes: every step is checked for crossed edges, and the page shows it.
     let menu = ScenarioMenu {
         check_crossings: true,
@@ -28,10 +35,7 @@ fn main() -> AppExit {
             menu.scenario(SCENES[0]).expect("a built-in scenario")
         }
     };
-    App::new()
-        .add_plugins(window_plugins("web demo"))
-        .add_plugins((StrandsPlugin::default(), DemoPlugins, PageFiguresPlugin))
-        .insert_resource(active)
+    app.insert_resource(active)
         .insert_resource(menu)
         // A page has no folder to record frames into.
         .insert_resource(UiKeys {

@@ -6,7 +6,8 @@ a few simulated seconds, and checks what a visitor would see: frames drawn (a
 screenshot that is not blank), the live figures the page receives (finite, every edge
 within 1e-9 of its length, no crossing, particles arriving), a rope dragged by the
 mouse, and the page's own panel (pause, step, run, the step size, a tool, a bad command
-refused with its reason, the scene switched in place). Prints each scene's figures,
+refused with its reason, the scene switched in place), and an unknown scene in the
+address (the first scene shown, the reason in the browser's console). Prints each scene's figures,
 real-time factor included.
 
 Usage: python3 tests/browser/test_web_demo.py [folder, default target/web-demo]
@@ -303,6 +304,18 @@ def panel(page, url):
           f"{f['scene']} in place", flush=True)
 
 
+def bad_scene(page, url, console):
+    """An unknown scene in the address: the first scene shown, and the console says why."""
+    console.clear()
+    page.goto(f"{url}/?scene=no_such_scene")
+    f = wait_for(page, lambda f: f["steps"] > 0, LOAD_TIMEOUT, "the page to start")
+    check(f["scene"] == "spaghetti_factory", f"showing {f['scene']}, not the first scene")
+    said = [m for m in console if "no_such_scene" in m]
+    check(said, f"no console message names the unknown scene; the last ones: {console[-5:]}")
+    print(f"unknown scene: the spaghetti factory shown; the console says {said[0]!r}",
+          flush=True)
+
+
 def main():
     folder = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/web-demo")
     check((folder / "index.html").exists() and (folder / "strands_bg.wasm").exists(),
@@ -315,10 +328,13 @@ def main():
                                                  args=CHROMIUM_ARGS)
             page = browser.new_page(viewport=VIEWPORT)
             page.on("pageerror", lambda e: errors.append(str(e)))
+            console = []
+            page.on("console", lambda m: console.append(m.text))
             factory(page, url, folder, "spaghetti_factory", 3.0)
             factory(page, url, folder, "meatball_factory", 3.0)
             rope(page, url, folder)
             panel(page, url)
+            bad_scene(page, url, console)
             browser.close()
     finally:
         server.shutdown()

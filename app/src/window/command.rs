@@ -63,30 +63,15 @@ impl PageCommand {
             }
             "dt" => {
                 let text = needs("a step in seconds")?;
-                let dt: f64 = text
+                let dt = text
                     .parse()
                     .map_err(|_| format!("dt {text:?}: not a number"))?;
-                if !DT_RANGE.contains(&dt) {
-                    return Err(format!(
-                        "dt {dt}: outside {:e} to {} s",
-                        DT_RANGE.start(),
-                        DT_RANGE.end()
-                    ));
-                }
-                Self::Dt(dt)
+                Self::Dt(within("dt", dt, &DT_RANGE)?)
             }
             "substeps" => {
                 let text = needs("a count")?;
-                let n: u32 =
-                    (text.parse()).map_err(|_| format!("substeps {text:?}: not a count"))?;
-                if !SUBSTEPS_RANGE.contains(&n) {
-                    return Err(format!(
-                        "substeps {n}: outside {} to {}",
-                        SUBSTEPS_RANGE.start(),
-                        SUBSTEPS_RANGE.end()
-                    ));
-                }
-                Self::Substeps(n)
+                let n = (text.parse()).map_err(|_| format!("substeps {text:?}: not a count"))?;
+                Self::Substeps(within("substeps", n, &SUBSTEPS_RANGE)?)
             }
             _ => {
                 return Err(format!(
@@ -130,6 +115,23 @@ impl PageCommand {
             Self::Substeps(n) => world.resource_mut::<StrandsConfig>().substeps = *n,
         }
         Ok(())
+    }
+}
+
+/// `value` if `range` holds it, or why not (NaN is outside every range).
+fn within<T: PartialOrd + std::fmt::Display>(
+    what: &str,
+    value: T,
+    range: &RangeInclusive<T>,
+) -> Result<T, String> {
+    if range.contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "{what} {value}: outside {} to {}",
+            range.start(),
+            range.end()
+        ))
     }
 }
 

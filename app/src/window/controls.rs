@@ -10,6 +10,7 @@ use bevy_strands::metrics::LengthErrorHistory;
 use bevy_strands::prelude::*;
 
 use super::layout::UiLayout;
+#[cfg(not(target_arch = "wasm32"))]
 use super::screenshot::ScreenshotPlugin;
 use super::tools::{ToolState, use_tools};
 use super::{ActiveScenario, ScenarioMenu, spawn_active_scenario};
@@ -110,13 +111,14 @@ impl Plugin for StrandsUiPlugin {
                 directory: PathBuf::from("frames"),
                 ..default()
             })
-            .add_plugins(ScreenshotPlugin)
             .add_systems(Update, (shortcuts, use_tools, trim_history));
         #[cfg(feature = "render")]
         app.add_plugins(super::ui::PanelPlugin);
-        // A page has no folder to write frames into, and leaves the encoders out.
+        // A page has no folder to write frames or screenshots into, and leaves the
+        // encoders out.
         #[cfg(not(target_arch = "wasm32"))]
-        app.add_systems(PostUpdate, export_frames);
+        app.add_plugins(ScreenshotPlugin)
+            .add_systems(PostUpdate, export_frames);
     }
 }
 
@@ -126,12 +128,6 @@ pub fn switch_scenario(world: &mut World, name: &str) -> Result<(), String> {
     let menu = world
         .get_resource::<ScenarioMenu>()
         .ok_or("this demo offers no other scenes")?;
-    if !menu.names.iter().any(|n| n == name) {
-        return Err(format!(
-            "no scene {name:?} in this demo; valid: {}",
-            menu.names.join(", ")
-        ));
-    }
     let active = menu.scenario(name).map_err(|e| e.to_string())?;
     world.insert_resource(active);
     reset(world);

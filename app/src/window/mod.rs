@@ -27,6 +27,8 @@ mod tools;
 #[cfg(feature = "render")]
 mod ui;
 mod view;
+#[cfg(all(feature = "web", target_arch = "wasm32"))]
+mod web_plugins;
 
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
@@ -46,9 +48,10 @@ pub use tools::{Tool, ToolState};
 pub use view::DemoViewPlugin;
 
 /// Bevy's default plugins for an example window: 1280×720, titled. On the web the
-/// window is the page's `<canvas id="strands">`, sized to its parent.
+/// window is the page's `<canvas id="strands">`, sized to its parent, and the list is
+/// the page's own (see `web_plugins`).
 pub fn window_plugins(title: &str) -> PluginGroupBuilder {
-    DefaultPlugins.set(WindowPlugin {
+    let window = WindowPlugin {
         primary_window: Some(Window {
             title: format!("bevy_strands: {title}"),
             resolution: WindowResolution::new(1280, 720),
@@ -57,7 +60,11 @@ pub fn window_plugins(title: &str) -> PluginGroupBuilder {
             ..default()
         }),
         ..default()
-    })
+    };
+    #[cfg(all(feature = "web", target_arch = "wasm32"))]
+    return web_plugins::WebPlugins.set(window);
+    #[cfg(not(all(feature = "web", target_arch = "wasm32")))]
+    DefaultPlugins.set(window)
 }
 
 /// Everything a demo window adds to the simulation: the scenario logic, the strands'
@@ -122,8 +129,16 @@ impl ScenarioMenu {
         })
     }
 
-    /// The built-in scenario `name` as this menu starts it.
+    /// The menu's scenario `name` as this menu starts it; a name the menu does not
+    /// offer is refused with the ones it does.
     pub fn scenario(&self, name: &str) -> Result<ActiveScenario, ScenarioError> {
+        if !self.names.iter().any(|n| n == name) {
+            return Err(ScenarioError::new(
+                name,
+                "name",
+                format!("not a scene of this demo; valid: {}", self.names.join(", ")),
+            ));
+        }
         let mut active = ActiveScenario::builtin(name)?;
         active.scenario.collisions.check_crossings |= self.check_crossings;
         Ok(active)
