@@ -9,6 +9,7 @@ use bevy::prelude::*;
 use bevy_strands::metrics::LengthErrorHistory;
 use bevy_strands::prelude::*;
 
+use super::command::SUBSTEPS_RANGE;
 use super::layout::UiLayout;
 #[cfg(not(target_arch = "wasm32"))]
 use super::screenshot::ScreenshotPlugin;
@@ -158,10 +159,11 @@ fn shortcuts(
     if pressed(bindings.record) && cfg!(not(target_arch = "wasm32")) {
         commands.queue(toggle_export);
     }
-    if pressed(bindings.more_substeps) {
+    // Within the range the panel and the page's commands accept.
+    if pressed(bindings.more_substeps) && step.substeps < *SUBSTEPS_RANGE.end() {
         step.substeps += 1;
     }
-    if pressed(bindings.fewer_substeps) && step.substeps > 1 {
+    if pressed(bindings.fewer_substeps) && step.substeps > *SUBSTEPS_RANGE.start() {
         step.substeps -= 1;
     }
     // Crossings counted from when checking is switched on.
@@ -245,5 +247,39 @@ fn trim_history(mut history: ResMut<LengthErrorHistory>) {
     if history.samples.len() > PLOT_SAMPLES {
         let excess = history.samples.len() - PLOT_SAMPLES / 2;
         history.samples.drain(..excess);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::ecs::system::RunSystemOnce;
+
+    use super::*;
+    use crate::fixtures;
+
+    /// Press `key` once and run the shortcuts; the substeps after.
+    fn press(app: &mut App, key: KeyCode) -> u32 {
+        let mut keys = ButtonInput::<KeyCode>::default();
+        keys.press(key);
+        app.insert_resource(keys);
+        app.world_mut().run_system_once(shortcuts).unwrap();
+        app.world().resource::<StrandsConfig>().substeps
+    }
+
+    #[test]
+    fn the_substep_keys_stay_within_the_accepted_range() {
+        let mut app = fixtures::app();
+        app.init_resource::<UiKeys>().init_resource::<UiLayout>();
+        app.world_mut().resource_mut::<StrandsConfig>().substeps = 499;
+        assert_eq!(press(&mut app, KeyCode::Equal), 500);
+        assert_eq!(press(&mut app, KeyCode::Equal), 500);
+        app.world_mut().resource_mut::<StrandsConfig>().substeps = 2;
+        assert_eq!(press(&mut app, KeyCode::Minus), 1);
+        assert_eq!(press(&mut app, KeyCode::Minus), 1);
+        // Space pauses and runs again.
+        press(&mut app, KeyCode::Space);
+        assert!(app.world().resource::<StrandsConfig>().paused);
+        press(&mut app, KeyCode::Space);
+        assert!(!app.world().resource::<StrandsConfig>().paused);
     }
 }
