@@ -97,7 +97,7 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32, split: u32) -
     }
     let saving = may_take_again(world, halvings);
     if saving {
-        world.resource_scope(|world, mut saves: Mut<HalvingSaves>| saves.save(world));
+        with_saves(world, |saves, world| saves.save(world));
     }
     let failsafe = world.resource::<StrandMetrics>().failsafe_steps;
     schedule.run(world);
@@ -106,9 +106,18 @@ fn step(world: &mut World, schedule: &mut Schedule, halvings: u32, split: u32) -
         return failed;
     }
     // (A halved step's own save replaces this one: it is no longer needed.)
-    world.resource_scope(|world, saves: Mut<HalvingSaves>| saves.restore(world));
+    with_saves(world, |saves, world| saves.restore(world));
     world.resource_mut::<StrandMetrics>().halved_steps += 1;
     halves(world, schedule, halvings, 0, failsafe)
+}
+
+/// Run `f` on the saves with the world at hand. The saves' lists are taken out and put
+/// back rather than the resource itself (`resource_scope`), which would move it out of
+/// its storage and back every step: a third of what saving cost a small scene.
+fn with_saves(world: &mut World, f: impl FnOnce(&mut HalvingSaves, &mut World)) {
+    let mut saves = std::mem::take(&mut *world.resource_mut::<HalvingSaves>());
+    f(&mut saves, world);
+    *world.resource_mut::<HalvingSaves>() = saves;
 }
 
 /// Take the step as two halves, each split `split` more times ahead; `failsafe` is

@@ -108,10 +108,25 @@ pub struct FiniteGuard {
     marked: usize,
     /// Per packed particle, whether it is in `frozen`.
     is_frozen: Vec<bool>,
+    /// What the stage checks froze this step, reported at the step's end (the checks
+    /// between stages read only what they scan, so a step that finds nothing pays for
+    /// little more than the scans).
+    found: Vec<Finding>,
     /// Every event, in order.
     pub events: Vec<NonFiniteState>,
     /// The energy check's account.
     energy: energy::EnergyAccount,
+}
+
+/// A stage check's finding, frozen at once and reported at the step's end.
+#[derive(Debug)]
+struct Finding {
+    stage: StepSet,
+    quantity: Quantity,
+    first: usize,
+    value: DVec2,
+    bad_particles: usize,
+    frozen_particles: usize,
 }
 
 /// Index of the first vector with a non-finite component. Scans in blocks whose test
@@ -132,7 +147,9 @@ pub(crate) fn add_guard(app: &mut App) {
         .add_message::<NonFiniteState>()
         .register_type::<Frozen>();
     let check = |stage: StepSet, quantity: Quantity| {
-        move |params: CheckParams| check_stage(stage, quantity, params)
+        move |guard: ResMut<FiniteGuard>, state: ResMut<ParticleState>, topology: Res<Topology>| {
+            check_stage(stage, quantity, guard, state, topology)
+        }
     };
     app.add_systems(
         StrandsStep,
@@ -197,7 +214,7 @@ fn begin_step(mut guard: ResMut<FiniteGuard>, state: Res<ParticleState>) {
     guard.start_position.extend_from_slice(&state.position);
 }
 
-/// What a check reads and writes.
+/// What the step's-end checks read and write to freeze and to report.
 #[derive(SystemParam)]
 struct CheckParams<'w, 's> {
     guard: ResMut<'w, FiniteGuard>,
@@ -210,10 +227,17 @@ struct CheckParams<'w, 's> {
 }
 
 /// After `stage`: hold what this tick froze, then scan `quantity` and freeze the
-/// islands of any non-finite particle.
-fn check_stage(stage: StepSet, quantity: Quantity, mut params: CheckParams) {
-    hold_frozen(&params.guard, &mut params.state);
-    let state = &params.state;
+/// islands of any non-finite particle at once (so the next stage never reads it); the
+/// finding is reported at the step's end, by [`check_stretch`].
+fn check_stage(
+    stage: StepSet,
+    quantity: Quantity,
+    mut guard: ResMut<FiniteGuard>,
+    mut state: ResMut<ParticleState>,
+    topology: Res<Topology>,
+) {
+    let (guard, state) = (&mut *guard, &mut *state);
+    hold_frozen(guard, state);
     let values = match quantity {
         Quantity::Force => &state.force,
         Quantity::Velocity => &state.velocity,
@@ -226,9 +250,29 @@ fn check_stage(stage: StepSet, quantity: Quantity, mut params: CheckParams) {
     let bad: Vec<usize> = (first..values.len())
         .filter(|&i| !values[i].is_finite())
         .collect();
-    // The Integrate stage has already counted the step.
-    let step = params.clock.steps + u64::from(stage != StepSet::Integrate);
-    params.freeze_and_report(&bad, (step, stage, first, quantity, value));
+    let frozen_particles = freeze(guard, state, &topology, &bad);
+    guard.found.push(Finding {
+        stage,
+        quantity,
+        first,
+        value,
+        bad_particles: bad.len(),
+        frozen_particles,
+    });
+}
+
+/// Freeze the islands of the `bad` packed particles and hold them; how many particles
+/// that froze.
+fn freeze(
+    guard: &mut FiniteGuard,
+    state: &mut ParticleState,
+    topology: &Topology,
+    bad: &[usize],
+) -> usize {
+    let before = guard.frozen.len();
+    freeze_islands(guard, state, topology, bad);
+    hold_frozen(guard, state);
+    guard.frozen.len() - before
 }
 
 impl CheckParams<'_, '_> {
@@ -240,11 +284,30 @@ impl CheckParams<'_, '_> {
         bad: &[usize],
         (step, stage, first, quantity, value): (u64, StepSet, usize, Quantity, DVec2),
     ) {
-        let (guard, state) = (&mut *self.guard, &mut *self.state);
-        let before = guard.frozen.len();
-        freeze_islands(guard, state, &self.topology, bad);
-        hold_frozen(guard, state);
-        let particle = state.entity[first];
+        let frozen = freeze(&mut self.guard, &mut self.state, &self.topology, bad);
+        let finding = Finding {
+            stage,
+            quantity,
+            first,
+            value,
+            bad_particles: bad.len(),
+            frozen_particles: frozen,
+        };
+        self.report(step, finding);
+    }
+
+    /// Say what `finding` froze in `step`: as a message, in the guard's record and in
+    /// the log.
+    fn report(&mut self, step: u64, finding: Finding) {
+        let Finding {
+            stage,
+            quantity,
+            value,
+            ..
+        } = finding;
+        let Some(&particle) = self.state.entity.get(finding.first) else {
+            return;
+        };
         let event = NonFiniteState {
             step,
             time: step.saturating_sub(1) as f64 * self.config.dt,
@@ -253,8 +316,8 @@ impl CheckParams<'_, '_> {
             strand: self.strands.get(particle).ok().map(|of| of.0),
             quantity,
             value,
-            bad_particles: bad.len(),
-            frozen_particles: guard.frozen.len() - before,
+            bad_particles: finding.bad_particles,
+            frozen_particles: finding.frozen_particles,
         };
         error!(
             "bevy_strands: step {step}, {stage:?} stage: particle {particle} has {} {value}; \
@@ -263,14 +326,19 @@ impl CheckParams<'_, '_> {
             event.frozen_particles
         );
         self.messages.write(event.clone());
-        guard.events.push(event);
+        self.guard.events.push(event);
     }
 }
 
-/// After the Measure stage (its errors measured): freeze the islands of constrained
-/// edges stretched past [`MAX_STRETCH`] (nothing to scan while the step's largest error
-/// is below it).
+/// After the Measure stage (its errors measured): report what the stage checks froze,
+/// then freeze the islands of constrained edges stretched past [`MAX_STRETCH`] (nothing
+/// to scan while the step's largest error is below it).
 fn check_stretch(mut params: CheckParams, metrics: Res<crate::metrics::StrandMetrics>) {
+    // The stage checks' findings of this step (the Integrate stage has counted it).
+    let found = std::mem::take(&mut params.guard.found);
+    for finding in found {
+        params.report(params.clock.steps, finding);
+    }
     if metrics.max_rel_length_error_now <= MAX_STRETCH {
         return;
     }
