@@ -8,22 +8,30 @@ use bevy_strands::guard::energy::MechanicalEnergy;
 use bevy_strands::prelude::*;
 use bevy_strands::world::topology::Topology;
 
-use crate::free::free_particles;
+use crate::free::FreeParticles;
 
 /// What drives a tick: its energy is then not compared with the ticks before.
-fn driven(world: &World, state: &ParticleState) -> bool {
+/// `tethers` keeps the query of tethered particles from tick to tick.
+fn driven(
+    world: &World,
+    state: &ParticleState,
+    tethers: &mut Option<QueryState<(), With<Tether>>>,
+) -> bool {
     let pushed = state
         .external_force
         .iter()
         .any(|f| *f != bevy::math::DVec2::ZERO);
-    let tethered = world
-        .try_query_filtered::<(), With<Tether>>()
-        .is_some_and(|mut q| q.iter(world).next().is_some());
+    if tethers.is_none() {
+        *tethers = world.try_query_filtered::<(), With<Tether>>();
+    }
+    let tethered = tethers
+        .as_mut()
+        .is_some_and(|q| q.iter(world).next().is_some());
     pushed || bevy_strands::guard::energy::driven(state, tethered)
 }
 
 /// The account, updated after every tick.
-#[derive(Clone, Debug, Default)]
+#[derive(Default)]
 pub struct EnergyLedger {
     /// Energy at the end of the first tick.
     pub start: Option<f64>,
@@ -37,6 +45,8 @@ pub struct EnergyLedger {
     pub driven_ticks: u64,
     particles: usize,
     counted: Vec<bool>,
+    free: FreeParticles,
+    tethers: Option<QueryState<(), With<Tether>>>,
 }
 
 impl EnergyLedger {
@@ -45,7 +55,7 @@ impl EnergyLedger {
         let state = world.resource::<ParticleState>();
         let topology = world.resource::<Topology>();
         let config = world.resource::<StrandsConfig>();
-        free_particles(world, &mut self.counted);
+        self.free.mark(world, &mut self.counted);
         let energy = MechanicalEnergy::of(
             state,
             (&topology.edges, &topology.bends),
@@ -61,7 +71,7 @@ impl EnergyLedger {
         self.particles = state.len();
         self.start.get_or_insert(energy);
         self.end = energy;
-        if changed || driven(world, state) {
+        if changed || driven(world, state, &mut self.tethers) {
             self.driven_ticks += 1;
             self.low = Some(energy);
             return;

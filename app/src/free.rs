@@ -8,13 +8,30 @@ use bevy_strands::world::particle::SolverIndex;
 
 /// Mark in `free` (one entry per packed particle) the free particles of `world`.
 pub fn free_particles(world: &World, free: &mut Vec<bool>) {
-    let state = world.resource::<ParticleState>();
-    free.clear();
-    free.extend(state.inverse_mass.iter().map(|&w| w > 0.0));
-    if let Some(mut asleep) = world.try_query_filtered::<&SolverIndex, With<Sleeping>>() {
-        for index in asleep.iter(world) {
-            if let Some(slot) = (*index).get().and_then(|i| free.get_mut(i)) {
-                *slot = true;
+    FreeParticles::default().mark(world, free);
+}
+
+/// The query of sleeping particles, kept from one call to the next: building it
+/// matches every archetype, which every tick of a small scene would pay again.
+#[derive(Default)]
+pub struct FreeParticles {
+    asleep: Option<QueryState<&'static SolverIndex, With<Sleeping>>>,
+}
+
+impl FreeParticles {
+    /// Mark in `free` (one entry per packed particle) the free particles of `world`.
+    pub fn mark(&mut self, world: &World, free: &mut Vec<bool>) {
+        let state = world.resource::<ParticleState>();
+        free.clear();
+        free.extend(state.inverse_mass.iter().map(|&w| w > 0.0));
+        if self.asleep.is_none() {
+            self.asleep = world.try_query_filtered::<&SolverIndex, With<Sleeping>>();
+        }
+        if let Some(asleep) = &mut self.asleep {
+            for index in asleep.iter(world) {
+                if let Some(slot) = (*index).get().and_then(|i| free.get_mut(i)) {
+                    *slot = true;
+                }
             }
         }
     }
