@@ -30,8 +30,11 @@ impl Plugin for HalvingPlugin {
             .add_systems(StrandsTick, run_steps.in_set(TickSet::Step));
         // What every step carries forward, for a step taken again in halves.
         app.save_for_halving::<ParticleState, ParticleState>(
-            |state, saved| saved.copy_from(state),
-            |state, saved| state.copy_from(saved),
+            |state, saved| saved.copy_step_from(state),
+            |state, saved| {
+                debug_assert_eq!(state.len(), saved.position.len(), "resized within a step");
+                state.copy_step_from(saved)
+            },
         )
         .save_for_halving::<StrandMetrics, StrandMetrics>(
             |metrics, saved| saved.copy_from(metrics),

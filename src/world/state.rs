@@ -90,6 +90,19 @@ impl ParticleState {
             .clone_from(&other.end_velocity_change);
     }
 
+    /// Copy from `other` only the arrays a step writes (positions, velocities, forces,
+    /// contact flags, end-of-step velocity changes): what step halving saves and puts
+    /// back. Entities, masses and external forces are set by the tick's gather and only
+    /// read by its steps, so a step's save need not move them (two fifths of the bytes).
+    pub fn copy_step_from(&mut self, other: &ParticleState) {
+        copy_buffer(&mut self.position, &other.position);
+        copy_buffer(&mut self.velocity, &other.velocity);
+        copy_buffer(&mut self.force, &other.force);
+        copy_buffer(&mut self.in_contact, &other.in_contact);
+        self.end_velocity_change
+            .clone_from(&other.end_velocity_change);
+    }
+
     pub(crate) fn resize(&mut self, entities: Vec<Entity>) {
         let n = entities.len();
         self.entity = entities;
