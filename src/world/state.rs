@@ -79,15 +79,10 @@ impl ParticleState {
     /// are as long).
     pub fn copy_from(&mut self, other: &ParticleState) {
         copy_buffer(&mut self.entity, &other.entity);
-        copy_buffer(&mut self.position, &other.position);
-        copy_buffer(&mut self.velocity, &other.velocity);
-        copy_buffer(&mut self.force, &other.force);
         copy_buffer(&mut self.external_force, &other.external_force);
         copy_buffer(&mut self.mass, &other.mass);
         copy_buffer(&mut self.inverse_mass, &other.inverse_mass);
-        copy_buffer(&mut self.in_contact, &other.in_contact);
-        self.end_velocity_change
-            .clone_from(&other.end_velocity_change);
+        self.copy_step_from(other);
     }
 
     /// Copy from `other` only the arrays a step writes (positions, velocities, forces,
