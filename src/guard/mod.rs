@@ -305,9 +305,10 @@ impl CheckParams<'_, '_> {
             value,
             ..
         } = finding;
-        let Some(&particle) = self.state.entity.get(finding.first) else {
-            return;
-        };
+        // Scanned from the same state, so the index is in range; were it not, the
+        // event is still told, with no particle to name.
+        let particle =
+            (self.state.entity.get(finding.first).copied()).unwrap_or(Entity::PLACEHOLDER);
         let event = NonFiniteState {
             step,
             time: step.saturating_sub(1) as f64 * self.config.dt,
